@@ -1,0 +1,90 @@
+#pragma once
+// Validated reading of one TOML table against a declared schema. Every problem becomes
+// one error with file:line:column and the full key path; reading goes on so that a user
+// sees all of a config's mistakes at once. The same schema prints config/schema.md.
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <toml++/toml.h>
+
+namespace covtrack {
+
+enum class ValueType { Integer, Float, String, Boolean, FloatArray, StringArray, Table };
+const char* to_string(ValueType type);
+
+struct KeySpec {
+  std::string_view key;
+  ValueType type;
+  std::string_view unit;           // "m", "Hz", "" ...
+  std::string_view default_value;  // empty: required
+  std::string_view doc;
+  double min = -std::numeric_limits<double>::infinity();  // inclusive, numbers and array items
+  double max = std::numeric_limits<double>::infinity();
+  std::size_t array_size = 0;  // FloatArray: exact item count, 0 = any
+};
+
+struct TableSpec {
+  std::string_view name;  // for the schema document, e.g. "devices.<name> (type = \"sim\")"
+  std::string_view reader;  // who reads it: "daemon", "sim driver", ...
+  std::vector<KeySpec> keys;
+};
+
+class ConfigErrors {
+ public:
+  void add(const std::string& file, const toml::source_region& where,
+           const std::string& key_path, const std::string& message);
+  bool empty() const { return errors_.empty(); }
+  const std::vector<std::string>& list() const { return errors_; }
+  std::string joined() const;
+
+ private:
+  std::vector<std::string> errors_;
+};
+
+class TableReader {
+ public:
+  // Reports every key of `table` that `spec` does not declare.
+  TableReader(const toml::table& table, std::string key_path, const TableSpec& spec,
+              std::string file, ConfigErrors& errors);
+
+  bool has(std::string_view key) const;
+  // Each getter checks type and range; on a problem it records an error and returns
+  // the fallback so reading can go on. A missing required key is an error too.
+  std::int64_t integer(std::string_view key, std::int64_t fallback = 0);
+  double number(std::string_view key, double fallback = 0);  // integers accepted
+  std::string string(std::string_view key, std::string fallback = {});
+  // One of the allowed words.
+  std::string choice(std::string_view key, const std::vector<std::string_view>& allowed,
+                     std::string fallback = {});
+  bool boolean(std::string_view key, bool fallback = false);
+  std::vector<double> numbers(std::string_view key);
+  std::vector<std::string> strings(std::string_view key);
+  // A sub-table, or nullptr if absent (an error if required or of the wrong type).
+  const toml::table* table(std::string_view key);
+
+  // Records a problem that only the caller can judge (e.g. two keys that conflict).
+  void error(std::string_view key, const std::string& message);
+  std::string path(std::string_view key) const;
+  const std::string& file() const { return file_; }
+  ConfigErrors& errors() { return errors_; }
+
+ private:
+  const KeySpec* spec_of(std::string_view key);
+  const toml::node* present(std::string_view key, const KeySpec** spec);
+  bool in_range(const KeySpec& spec, double value, std::string_view key, const toml::node& node);
+
+  const toml::table& table_;
+  std::string key_path_;
+  const TableSpec& spec_;
+  std::string file_;
+  ConfigErrors& errors_;
+};
+
+// Markdown for config/schema.md: one section per table, one row per key.
+std::string schema_markdown(const std::vector<const TableSpec*>& tables);
+
+}  // namespace covtrack

@@ -1,0 +1,58 @@
+#pragma once
+// The contract between a driver and the daemon that hosts it. A driver never touches
+// LCM: it reads its device, turns bytes into poses with covariances, and hands them to
+// a SampleSink. The daemon owns threads, restarts and publishing.
+#include <cstddef>
+#include <cstdint>
+#include <stop_token>
+#include <string>
+
+#include "covtrack/protocol/pose_message.hpp"
+#include "covtrack/protocol/result.hpp"
+#include "covtrack/protocol/se3.hpp"
+
+namespace covtrack {
+
+struct PoseSample {
+  std::string sensor;
+  std::string parent_frame;
+  std::string child_frame;
+  std::int64_t measurement_time_us = 0;
+  Pose T_parent_child = Pose::Identity();
+  Mat6 covariance = Mat6::Zero();  // BODY convention (protocol/README.md)
+  TrackingStatus status = TrackingStatus::Ok;
+};
+
+struct TruthSample {
+  std::string sensor;
+  std::string parent_frame;
+  std::string child_frame;
+  std::int64_t measurement_time_us = 0;
+  Pose T_parent_child = Pose::Identity();
+};
+
+enum class ByteDirection : std::int8_t { FromDevice = 0, ToDevice = 1 };
+
+// Everything a driver reports. Calls come from the driver's own thread only.
+class SampleSink {
+ public:
+  virtual ~SampleSink() = default;
+  virtual void pose(const PoseSample& sample) = 0;
+  virtual void truth(const TruthSample& sample) = 0;
+  virtual void raw(ByteDirection direction, const std::uint8_t* data, std::size_t size) = 0;
+  // Bad frames skipped by a decoder, resynchronisations, data the driver had to drop.
+  virtual void count_error(const std::string& what) = 0;
+  virtual void count_resync() = 0;
+  virtual void count_drop() = 0;
+};
+
+class Driver {
+ public:
+  virtual ~Driver() = default;
+  // Runs until stop is requested (returns success) or the device fails (returns the
+  // error; the daemon restarts the driver after a back-off). Must notice a stop
+  // request within 100 ms and must not throw.
+  virtual Result<void> run(SampleSink& sink, std::stop_token stop) = 0;
+};
+
+}  // namespace covtrack

@@ -1,0 +1,236 @@
+#include "covtrack/devices/config_reader.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <fmt/format.h>
+
+namespace covtrack {
+
+const char* to_string(ValueType type) {
+  switch (type) {
+    case ValueType::Integer: return "integer";
+    case ValueType::Float: return "number";
+    case ValueType::String: return "string";
+    case ValueType::Boolean: return "boolean";
+    case ValueType::FloatArray: return "array of numbers";
+    case ValueType::StringArray: return "array of strings";
+    case ValueType::Table: return "table";
+  }
+  return "?";
+}
+
+void ConfigErrors::add(const std::string& file, const toml::source_region& where,
+                       const std::string& key_path, const std::string& message) {
+  errors_.push_back(fmt::format("{}:{}:{}: {}: {}", file, where.begin.line, where.begin.column,
+                                key_path, message));
+}
+
+std::string ConfigErrors::joined() const {
+  std::string out;
+  for (const auto& e : errors_) out += e + "\n";
+  return out;
+}
+
+TableReader::TableReader(const toml::table& table, std::string key_path, const TableSpec& spec,
+                         std::string file, ConfigErrors& errors)
+    : table_(table), key_path_(std::move(key_path)), spec_(spec), file_(std::move(file)),
+      errors_(errors) {
+  for (const auto& [key, node] : table_) {
+    if (!spec_of(key.str())) {
+      std::string known;
+      for (const auto& k : spec_.keys) known += (known.empty() ? "" : ", ") + std::string(k.key);
+      errors_.add(file_, key.source(), path(key.str()),
+                  fmt::format("unknown key (known keys here: {})", known));
+    }
+  }
+}
+
+std::string TableReader::path(std::string_view key) const {
+  return key_path_.empty() ? std::string(key) : key_path_ + "." + std::string(key);
+}
+
+const KeySpec* TableReader::spec_of(std::string_view key) {
+  auto it = std::find_if(spec_.keys.begin(), spec_.keys.end(),
+                         [&](const KeySpec& k) { return k.key == key; });
+  return it == spec_.keys.end() ? nullptr : &*it;
+}
+
+bool TableReader::has(std::string_view key) const { return table_.contains(key); }
+
+void TableReader::error(std::string_view key, const std::string& message) {
+  const toml::node* node = table_.get(key);
+  errors_.add(file_, node ? node->source() : table_.source(), path(key), message);
+}
+
+// The node for `key` if present; records "missing" for a required absent key.
+const toml::node* TableReader::present(std::string_view key, const KeySpec** spec) {
+  *spec = spec_of(key);
+  if (!*spec) throw std::logic_error("key '" + std::string(key) + "' is not in the schema");
+  const toml::node* node = table_.get(key);
+  if (!node && (*spec)->default_value.empty())
+    errors_.add(file_, table_.source(), path(key),
+                fmt::format("missing required key ({}{}{})", to_string((*spec)->type),
+                            (*spec)->unit.empty() ? "" : ", in ", (*spec)->unit));
+  return node;
+}
+
+bool TableReader::in_range(const KeySpec& spec, double v, std::string_view key,
+                           const toml::node& node) {
+  if (!std::isfinite(v) || v < spec.min || v > spec.max) {
+    errors_.add(file_, node.source(), path(key),
+                fmt::format("{} is out of range [{}, {}]", v, spec.min, spec.max));
+    return false;
+  }
+  return true;
+}
+
+namespace {
+std::string wrong_type(const KeySpec& spec, const toml::node& node) {
+  std::ostringstream got;
+  got << node.type();
+  return fmt::format("expected {}, found {}", to_string(spec.type), got.str());
+}
+}  // namespace
+
+std::int64_t TableReader::integer(std::string_view key, std::int64_t fallback) {
+  const KeySpec* spec;
+  const toml::node* node = present(key, &spec);
+  if (!node) return fallback;
+  if (!node->is_integer()) {
+    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
+    return fallback;
+  }
+  const auto v = node->as_integer()->get();
+  return in_range(*spec, static_cast<double>(v), key, *node) ? v : fallback;
+}
+
+double TableReader::number(std::string_view key, double fallback) {
+  const KeySpec* spec;
+  const toml::node* node = present(key, &spec);
+  if (!node) return fallback;
+  const auto v = node->value<double>();  // accepts integers too
+  if (!v || !(node->is_floating_point() || node->is_integer())) {
+    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
+    return fallback;
+  }
+  return in_range(*spec, *v, key, *node) ? *v : fallback;
+}
+
+std::string TableReader::string(std::string_view key, std::string fallback) {
+  const KeySpec* spec;
+  const toml::node* node = present(key, &spec);
+  if (!node) return fallback;
+  if (!node->is_string()) {
+    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
+    return fallback;
+  }
+  return node->as_string()->get();
+}
+
+std::string TableReader::choice(std::string_view key, const std::vector<std::string_view>& allowed,
+                                std::string fallback) {
+  if (!has(key)) return string(key, std::move(fallback));
+  std::string v = string(key, "");
+  if (std::find(allowed.begin(), allowed.end(), v) != allowed.end()) return v;
+  std::string list;
+  for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+  error(key, fmt::format("'{}' is not one of: {}", v, list));
+  return fallback;
+}
+
+bool TableReader::boolean(std::string_view key, bool fallback) {
+  const KeySpec* spec;
+  const toml::node* node = present(key, &spec);
+  if (!node) return fallback;
+  if (!node->is_boolean()) {
+    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
+    return fallback;
+  }
+  return node->as_boolean()->get();
+}
+
+std::vector<double> TableReader::numbers(std::string_view key) {
+  const KeySpec* spec;
+  const toml::node* node = present(key, &spec);
+  if (!node) return {};
+  const toml::array* arr = node->as_array();
+  if (!arr) {
+    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
+    return {};
+  }
+  if (spec->array_size && arr->size() != spec->array_size) {
+    errors_.add(file_, node->source(), path(key),
+                fmt::format("expected {} numbers, found {}", spec->array_size, arr->size()));
+    return {};
+  }
+  std::vector<double> out;
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const toml::node& item = *arr->get(i);
+    const auto v = item.value<double>();
+    const std::string item_key = fmt::format("{}[{}]", key, i);
+    if (!v || !(item.is_floating_point() || item.is_integer())) {
+      errors_.add(file_, item.source(), path(item_key), "expected a number");
+      return {};
+    }
+    if (!in_range(*spec, *v, item_key, item)) return {};
+    out.push_back(*v);
+  }
+  return out;
+}
+
+std::vector<std::string> TableReader::strings(std::string_view key) {
+  const KeySpec* spec;
+  const toml::node* node = present(key, &spec);
+  if (!node) return {};
+  const toml::array* arr = node->as_array();
+  if (!arr) {
+    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
+    return {};
+  }
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const toml::node& item = *arr->get(i);
+    if (!item.is_string()) {
+      errors_.add(file_, item.source(), path(fmt::format("{}[{}]", key, i)), "expected a string");
+      return {};
+    }
+    out.push_back(item.as_string()->get());
+  }
+  return out;
+}
+
+const toml::table* TableReader::table(std::string_view key) {
+  const KeySpec* spec;
+  const toml::node* node = present(key, &spec);
+  if (!node) return nullptr;
+  if (!node->is_table()) {
+    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
+    return nullptr;
+  }
+  return node->as_table();
+}
+
+std::string schema_markdown(const std::vector<const TableSpec*>& tables) {
+  std::string out;
+  for (const TableSpec* t : tables) {
+    out += fmt::format("## `{}`\n\nRead by: {}.\n\n", t->name, t->reader);
+    out += "| key | type | unit | default | range | meaning |\n|---|---|---|---|---|---|\n";
+    for (const KeySpec& k : t->keys) {
+      std::string range;
+      if (std::isfinite(k.min) || std::isfinite(k.max))
+        range = fmt::format("[{}, {}]", std::isfinite(k.min) ? fmt::format("{}", k.min) : "-inf",
+                            std::isfinite(k.max) ? fmt::format("{}", k.max) : "inf");
+      if (k.array_size) range += fmt::format("{}{} items", range.empty() ? "" : ", ", k.array_size);
+      out += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", k.key, to_string(k.type),
+                         k.unit.empty() ? "" : k.unit,
+                         k.default_value.empty() ? "**required**" : std::string(k.default_value),
+                         range, k.doc);
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+}  // namespace covtrack

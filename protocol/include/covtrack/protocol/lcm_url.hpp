@@ -1,0 +1,23 @@
+#pragma once
+// Opening LCM without its silent failure modes: an unusable URL is reported at once,
+// with how to fix it, instead of a ~10 s self-test hang on the first subscribe.
+#include <memory>
+#include <string>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "covtrack/protocol/result.hpp"
+
+namespace covtrack {
+
+// The URL LCM would use: the argument if non-empty, else $LCM_DEFAULT_URL, else LCM's
+// built-in default.
+std::string effective_lcm_url(const std::string& url);
+
+// Checks that the URL can work on this machine (for udpm: a route to the group).
+Result<void> check_lcm_url(const std::string& url);
+
+// check_lcm_url, then create the instance.
+Result<std::unique_ptr<lcm::LCM>> open_lcm(const std::string& url);
+
+}  // namespace covtrack

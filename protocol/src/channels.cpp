@@ -1,0 +1,42 @@
+#include "covtrack/protocol/channels.hpp"
+
+#include <algorithm>
+
+namespace covtrack {
+
+bool is_valid_name(std::string_view name) {
+  return !name.empty() && name.size() <= kMaxNameLength &&
+         std::all_of(name.begin(), name.end(), [](char ch) {
+           return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
+                  (ch >= '0' && ch <= '9') || ch == '_' || ch == '-';
+         });
+}
+
+namespace {
+std::string join(std::string_view prefix, std::string_view a, std::string_view b = {}) {
+  std::string out(prefix);
+  out += a;
+  if (!b.empty()) {
+    out += '/';
+    out += b;
+  }
+  return out;
+}
+}  // namespace
+
+std::string pose_channel(std::string_view d, std::string_view s) { return join(kPosePrefix, d, s); }
+std::string truth_channel(std::string_view d, std::string_view s) { return join(kTruthPrefix, d, s); }
+std::string status_channel(std::string_view d) { return join(kStatusPrefix, d); }
+std::string raw_channel(std::string_view d) { return join(kRawPrefix, d); }
+
+std::optional<StreamId> parse_pose_channel(std::string_view channel) {
+  if (!channel.starts_with(kPosePrefix)) return std::nullopt;
+  channel.remove_prefix(kPosePrefix.size());
+  const auto slash = channel.find('/');
+  if (slash == std::string_view::npos) return std::nullopt;
+  StreamId id{std::string(channel.substr(0, slash)), std::string(channel.substr(slash + 1))};
+  if (!is_valid_name(id.device) || !is_valid_name(id.sensor)) return std::nullopt;
+  return id;
+}
+
+}  // namespace covtrack

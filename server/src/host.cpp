@@ -1,0 +1,36 @@
+#include "host.hpp"
+
+#include <chrono>
+
+#include "covtrack/devices/interruptible_sleep.hpp"
+
+namespace covtrack::server {
+
+Host::Host(const DaemonConfig& config, lcm::LCM& lcm) : settings_(config.daemon), publisher_(lcm) {
+  for (const auto& device : config.devices)
+    runners_.push_back(std::make_unique<DeviceRunner>(device, publisher_, settings_));
+}
+
+Host::~Host() { stop(); }
+
+void Host::start() {
+  for (auto& r : runners_) r->start();
+  heartbeat_thread_ = std::jthread([this](std::stop_token stop) { publish_heartbeats(stop); });
+}
+
+void Host::stop() {
+  // Ask everyone first, then wait: the stop takes as long as the slowest, not the sum.
+  heartbeat_thread_.request_stop();
+  for (auto& r : runners_) r->request_stop();
+  for (auto& r : runners_) r->join();
+  if (heartbeat_thread_.joinable()) heartbeat_thread_.join();
+}
+
+void Host::publish_heartbeats(std::stop_token stop) {
+  using namespace std::chrono;
+  const auto period = duration_cast<steady_clock::duration>(duration<double>(1.0 / settings_.heartbeat_hz));
+  for (auto next = steady_clock::now() + period; sleep_until(stop, next); next += period)
+    for (auto& r : runners_) publisher_.status(r->heartbeat());
+}
+
+}  // namespace covtrack::server

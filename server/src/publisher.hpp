@@ -1,0 +1,40 @@
+#pragma once
+// The daemon's single LCM publisher. Drivers reach it through their DeviceSink; it
+// stamps publish time and the per-stream sequence numbers, which survive driver restarts
+// so that a client sees a gap only when a message was really lost.
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <covtrack/device_status_t.hpp>
+
+#include "covtrack/devices/driver.hpp"
+
+namespace covtrack::server {
+
+class Publisher {
+ public:
+  explicit Publisher(lcm::LCM& lcm) : lcm_(lcm) {}
+
+  // Each returns false if LCM failed to send (the caller counts it as a drop).
+  bool pose(const std::string& device, const PoseSample& sample);
+  bool truth(const std::string& device, const TruthSample& sample);
+  bool raw(const std::string& device, ByteDirection direction, const std::uint8_t* data,
+           std::size_t size);
+  bool status(const device_status_t& status);
+
+ private:
+  std::int64_t next_sequence(const std::string& channel);
+  template <typename Msg>
+  bool send(const std::string& channel, const Msg& msg);
+
+  lcm::LCM& lcm_;
+  std::mutex mutex_;  // LCM's publish is thread-safe; this guards the counters and buffer
+  std::unordered_map<std::string, std::int64_t> sequences_;
+  std::vector<std::uint8_t> buffer_;
+};
+
+}  // namespace covtrack::server

@@ -1,0 +1,11 @@
+#pragma once
+// Each subcommand of `covtrack` registers itself on the app: one file per subcommand.
+#include <CLI/CLI.hpp>
+
+namespace covtrack::cli {
+
+void add_echo_command(CLI::App& app);
+void add_record_command(CLI::App& app);
+void add_replay_command(CLI::App& app);
+
+}  // namespace covtrack::cli
