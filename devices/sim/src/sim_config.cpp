@@ -112,12 +112,13 @@ Mat6 read_covariance(TableReader& r) {
       r.error("covariance", fmt::format("{}: {}", to_string(problem->defect), problem->detail));
     return cov;
   }
-  const auto sm = r.numbers("sigma_m");
-  const auto sr = r.numbers("sigma_rad");
-  if (sm.size() != 3 || sr.size() != 3) {
-    r.error(sm.size() != 3 ? "sigma_m" : "sigma_rad", "both sigma_m and sigma_rad are needed");
+  if (!r.has("sigma_m") || !r.has("sigma_rad")) {
+    r.error(r.has("sigma_m") ? "sigma_m" : "sigma_rad", "both sigma_m and sigma_rad are needed");
     return Mat6::Identity() * 1e-6;
   }
+  const auto sm = r.numbers("sigma_m");
+  const auto sr = r.numbers("sigma_rad");
+  if (sm.size() != 3 || sr.size() != 3) return Mat6::Identity() * 1e-6;  // already reported
   for (int i = 0; i < 3; ++i) {
     cov(i, i) = sm[i] * sm[i];
     cov(i + 3, i + 3) = sr[i] * sr[i];

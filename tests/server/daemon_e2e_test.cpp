@@ -1,0 +1,178 @@
+// End to end, as separate processes, inside a private network namespace (see
+// tests/netns_run.sh): covtrackd publishing over real UDP multicast, a subscriber here.
+#include <gtest/gtest.h>
+
+#include <poll.h>
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <mutex>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <covtrack/device_status_t.hpp>
+#include <covtrack/pose_cov_t.hpp>
+#include <covtrack/truth_pose_t.hpp>
+
+#include "covtrack/protocol/pose_message.hpp"
+#include "daemon_process.hpp"
+
+using namespace covtrack;
+
+namespace {
+
+// A distinct port per test keeps tests apart (LCM 1.3.1: groups on one port cross-talk).
+std::string url_for(int port) {
+  return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0&recv_buf_size=8388608";
+}
+
+struct StreamLog {
+  std::int64_t received = 0, gaps = 0, last_sequence = -1;
+  std::int64_t max_interval_us = 0, last_receive_us = 0;
+  std::map<std::int64_t, pose_cov_t> by_time;  // for pairing with the truth
+};
+
+class Collector {
+ public:
+  explicit Collector(const std::string& url) : lcm_(url) {
+    lcm_.subscribe("covtrack/pose/.*", &Collector::on_pose, this)->setQueueCapacity(1 << 20);
+    lcm_.subscribe("covtrack/truth/.*", &Collector::on_truth, this)->setQueueCapacity(1 << 20);
+    lcm_.subscribe("covtrack/status/.*", &Collector::on_status, this)->setQueueCapacity(1000);
+  }
+  bool good() { return lcm_.good(); }
+
+  void run_for(double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    pollfd pfd{lcm_.getFileno(), POLLIN, 0};
+    while (std::chrono::steady_clock::now() < end)
+      if (poll(&pfd, 1, 20) > 0) lcm_.handle();
+  }
+
+  std::map<std::string, StreamLog> poses;
+  std::map<std::string, std::map<std::int64_t, truth_pose_t>> truths;
+  std::map<std::string, device_status_t> status;
+  bool keep_samples = false;
+
+ private:
+  static std::int64_t now() {
+    return std::chrono::duration_cast<std::chrono::microseconds>(
+               std::chrono::steady_clock::now().time_since_epoch()).count();
+  }
+  void on_pose(const lcm::ReceiveBuffer*, const std::string& ch, const pose_cov_t* m) {
+    StreamLog& s = poses[ch];
+    if (s.last_sequence >= 0 && m->sequence > s.last_sequence + 1)
+      s.gaps += m->sequence - s.last_sequence - 1;
+    const std::int64_t t = now();
+    if (s.last_receive_us) s.max_interval_us = std::max(s.max_interval_us, t - s.last_receive_us);
+    s.last_receive_us = t;
+    s.last_sequence = m->sequence;
+    ++s.received;
+    if (keep_samples) s.by_time[m->measurement_time_us] = *m;
+  }
+  void on_truth(const lcm::ReceiveBuffer*, const std::string&, const truth_pose_t* m) {
+    if (keep_samples) truths[m->device + "/" + m->sensor][m->measurement_time_us] = *m;
+  }
+  void on_status(const lcm::ReceiveBuffer*, const std::string&, const device_status_t* m) {
+    status[m->device] = *m;
+  }
+
+  lcm::LCM lcm_;
+};
+
+std::string sim_device(const std::string& name, int sensors, double rate_hz,
+                       const std::string& extra = "") {
+  return "[devices." + name + "]\ntype = \"sim\"\nsensor_count = " + std::to_string(sensors) +
+         "\nrate_hz = " + std::to_string(rate_hz) +
+         "\nsigma_m = [0.001, 0.002, 0.001]\nsigma_rad = [0.004, 0.002, 0.003]\n" + extra;
+}
+
+}  // namespace
+
+TEST(DaemonEndToEnd, TenSensorsAt1kHzWithoutGapsAndStopWithinOneSecond) {
+  const std::string url = url_for(7701);
+  Collector c(url);
+  ASSERT_TRUE(c.good());
+  test::DaemonProcess daemon(sim_device("rig", 10, 1000), url);
+  c.run_for(5.0);
+
+  ASSERT_EQ(c.poses.size(), 10u);
+  std::int64_t total = 0;
+  for (const auto& [channel, s] : c.poses) {
+    EXPECT_EQ(s.gaps, 0) << channel;
+    EXPECT_GT(s.received, 3500) << channel;  // ~1 kHz for the ~4.5 s after start-up
+    total += s.received;
+  }
+  EXPECT_GT(total, 35000);
+  ASSERT_TRUE(c.status.count("rig"));
+  EXPECT_EQ(int{c.status["rig"].state}, int{device_status_t::STATE_RUNNING});
+  EXPECT_NEAR(c.status["rig"].rate_hz, 10000, 1500);
+
+  int status = 0;
+  const double stop_s = daemon.stop(SIGTERM, status);
+  EXPECT_GE(stop_s, 0.0) << "covtrackd did not exit within 5 s of SIGTERM";
+  EXPECT_LT(stop_s, 1.0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+}
+
+TEST(DaemonEndToEnd, NeesAgainstTheTruthChannelIsChiSquare6) {
+  const std::string url = url_for(7702);
+  Collector c(url);
+  c.keep_samples = true;
+  test::DaemonProcess daemon(sim_device("rig", 4, 500), url);
+  c.run_for(2.5);
+
+  Mat6 cov = Mat6::Zero();
+  cov.diagonal() << 1e-6, 4e-6, 1e-6, 16e-6, 4e-6, 9e-6;
+  const Mat6 info = cov.inverse();
+  double sum = 0;
+  int n = 0;
+  for (const auto& [channel, s] : c.poses) {
+    for (const auto& [t, msg] : s.by_time) {
+      auto& truth = c.truths[msg.device + "/" + msg.sensor];
+      auto it = truth.find(t);
+      if (it == truth.end()) continue;
+      const Mat6 reported = body_covariance_of(msg);
+      ASSERT_LT((reported - cov).norm(), 1e-12);  // the wire carries the configured covariance
+      const Vec6 e = boxminus(pose_of(it->second), pose_of(msg));
+      sum += e.dot(info * e);
+      ++n;
+    }
+  }
+  ASSERT_GE(n, 2000);
+  const double mean = sum / n;
+  EXPECT_NEAR(mean, 6.0, 2.576 * std::sqrt(12.0 / n)) << "over " << n << " pairs";
+}
+
+TEST(DaemonEndToEnd, FailingDeviceRestartsWhileTheOtherKeepsPublishing) {
+  const std::string url = url_for(7703);
+  Collector c(url);
+  const std::string config =
+      "[daemon]\nrestart_backoff_initial_s = 0.2\nrestart_backoff_max_s = 0.4\n" +
+      sim_device("steady", 1, 200) +
+      sim_device("flaky", 1, 200, "inject_failure_every_s = 0.3\n");
+  test::DaemonProcess daemon(config, url);
+  c.run_for(3.0);
+
+  const auto& steady = c.poses["covtrack/pose/steady/s0"];
+  EXPECT_GT(steady.received, 450);
+  EXPECT_EQ(steady.gaps, 0);
+  EXPECT_LT(steady.max_interval_us, 50000) << "the steady device stalled";
+  ASSERT_TRUE(c.status.count("flaky"));
+  EXPECT_GE(c.status["flaky"].restarts, 2);
+  EXPECT_GE(c.status["flaky"].errors, 2);
+  EXPECT_NE(c.status["flaky"].last_error.find("injected failure"), std::string::npos);
+  // Sequence numbers survive restarts: the flaky stream has no gaps either.
+  EXPECT_EQ(c.poses["covtrack/pose/flaky/s0"].gaps, 0);
+  EXPECT_EQ(c.status["steady"].restarts, 0);
+}
+
+TEST(DaemonEndToEnd, SigintStopsToo) {
+  const std::string url = url_for(7704);
+  test::DaemonProcess daemon(sim_device("rig", 1, 100), url);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  int status = 0;
+  const double stop_s = daemon.stop(SIGINT, status);
+  EXPECT_GE(stop_s, 0.0);
+  EXPECT_LT(stop_s, 1.0);
+}

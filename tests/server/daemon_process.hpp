@@ -1,0 +1,55 @@
+#pragma once
+// Starts covtrackd as a separate process for end-to-end tests, and stops it with a signal.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <string>
+#include <thread>
+
+namespace covtrack::test {
+
+class DaemonProcess {
+ public:
+  DaemonProcess(const std::string& config_text, const std::string& lcm_url) {
+    config_path_ = ::testing::TempDir() + "/covtrackd_e2e_" + std::to_string(getpid()) + ".toml";
+    std::ofstream(config_path_) << config_text;
+    pid_ = fork();
+    if (pid_ == 0) {
+      const std::string exe = COVTRACK_BINARY_DIR "/server/covtrackd";
+      execl(exe.c_str(), exe.c_str(), "--config", config_path_.c_str(), "--lcm-url",
+            lcm_url.c_str(), "--log-level", "warn", nullptr);
+      _exit(127);
+    }
+  }
+  ~DaemonProcess() {
+    if (pid_ > 0 && !exited_) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+
+  // Sends the signal; returns the seconds until the process exited (or -1 after 5 s)
+  // and its exit status through `status`.
+  double stop(int signal, int& status) {
+    const auto t0 = std::chrono::steady_clock::now();
+    kill(pid_, signal);
+    while (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5)) {
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        exited_ = true;
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return -1;
+  }
+
+ private:
+  std::string config_path_;
+  pid_t pid_ = -1;
+  bool exited_ = false;
+};
+
+}  // namespace covtrack::test
