@@ -82,3 +82,13 @@ TEST(CovarianceConventions, RoundTripsAreExact) {
     EXPECT_LT((back - cov).norm(), 1e-15 * 1e6 * cov.norm());
   }
 }
+
+// protocol/README.md, "Worked example": the numbers printed there.
+TEST(CovarianceConventions, ReadmeWorkedExample) {
+  const Pose T = pose_from(Vec3(1, 0, 0), Eigen::Quaterniond(std::sqrt(0.5), 0, 0, std::sqrt(0.5)));
+  Mat6 body = Mat6::Zero();
+  body.diagonal() << 1e-6, 1e-4, 1e-4, 1e-6, 1e-6, 1e-6;
+  Mat6 expected = Mat6::Zero();
+  expected.diagonal() << 1e-4, 1e-6, 1e-4, 1e-6, 1e-6, 1e-6;
+  EXPECT_LT((body_to_parent(T, body) - expected).norm(), 1e-15);
+}
