@@ -2,7 +2,9 @@
 // truth has the chi-square(6) mean.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <numeric>
 #include <cmath>
 #include <thread>
 
@@ -43,14 +45,10 @@ void run_until(test::CaptureSink& sink, const sim::SimConfig& config, std::size_
   t.join();
 }
 
-struct Nees {
-  double mean = 0;
-  std::size_t count = 0;
-};
-
-Nees nees(const test::CaptureSink& sink, const Mat6& claimed) {
+// NEES of every OK report against the truth of the same time.
+std::vector<double> nees_values(const test::CaptureSink& sink, const Mat6& claimed) {
   const Mat6 info = claimed.inverse();
-  Nees out;
+  std::vector<double> out;
   for (std::size_t i = 0; i < sink.poses.size(); ++i) {
     const auto& p = sink.poses[i];
     const auto& t = sink.truths[i];
@@ -58,11 +56,19 @@ Nees nees(const test::CaptureSink& sink, const Mat6& claimed) {
     EXPECT_EQ(p.measurement_time_us, t.measurement_time_us);
     if (p.status != TrackingStatus::Ok) continue;
     const Vec6 e = boxminus(t.T_parent_child, p.T_parent_child);  // T_true = T_est Exp(e)
-    out.mean += e.dot(info * e);
-    ++out.count;
+    out.push_back(e.dot(info * e));
   }
-  out.mean /= static_cast<double>(out.count);
   return out;
+}
+
+struct Nees {
+  double mean = 0;
+  std::size_t count = 0;
+};
+
+Nees nees(const test::CaptureSink& sink, const Mat6& claimed) {
+  const auto v = nees_values(sink, claimed);
+  return {std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()), v.size()};
 }
 
 // Two-sided 99% bounds of the mean of n chi-square(6) draws (normal approximation,
@@ -74,14 +80,9 @@ bool inside_99(const Nees& n) {
 constexpr double kChi2_6_99 = 16.812;
 
 double fraction_above(const test::CaptureSink& sink, const Mat6& claimed, double threshold) {
-  const Mat6 info = claimed.inverse();
-  std::size_t above = 0, count = 0;
-  for (std::size_t i = 0; i < sink.poses.size(); ++i) {
-    const Vec6 e = boxminus(sink.truths[i].T_parent_child, sink.poses[i].T_parent_child);
-    above += e.dot(info * e) > threshold;
-    ++count;
-  }
-  return static_cast<double>(above) / static_cast<double>(count);
+  const auto v = nees_values(sink, claimed);
+  return static_cast<double>(std::count_if(v.begin(), v.end(), [&](double x) { return x > threshold; })) /
+         static_cast<double>(v.size());
 }
 
 }  // namespace

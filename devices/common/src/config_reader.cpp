@@ -94,39 +94,52 @@ std::string wrong_type(const KeySpec& spec, const toml::node& node) {
 }
 }  // namespace
 
+namespace {
+bool has_type(const toml::node& node, ValueType type) {
+  switch (type) {
+    case ValueType::Integer: return node.is_integer();
+    case ValueType::Float: return node.is_integer() || node.is_floating_point();
+    case ValueType::String: return node.is_string();
+    case ValueType::Boolean: return node.is_boolean();
+    case ValueType::FloatArray:
+    case ValueType::StringArray: return node.is_array();
+    case ValueType::Table: return node.is_table();
+  }
+  return false;
+}
+}  // namespace
+
+// The node for `key` if it is present and of the type its spec declares; otherwise
+// nothing, with the problem recorded (a missing optional key is no problem).
+const toml::node* TableReader::typed(std::string_view key, const KeySpec** spec) {
+  const toml::node* node = present(key, spec);
+  if (node && !has_type(*node, (*spec)->type)) {
+    errors_.add(file_, node->source(), path(key), wrong_type(**spec, *node));
+    return nullptr;
+  }
+  return node;
+}
+
 std::int64_t TableReader::integer(std::string_view key, std::int64_t fallback) {
   const KeySpec* spec;
-  const toml::node* node = present(key, &spec);
+  const toml::node* node = typed(key, &spec);
   if (!node) return fallback;
-  if (!node->is_integer()) {
-    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
-    return fallback;
-  }
   const auto v = node->as_integer()->get();
   return in_range(*spec, static_cast<double>(v), key, *node) ? v : fallback;
 }
 
 double TableReader::number(std::string_view key, double fallback) {
   const KeySpec* spec;
-  const toml::node* node = present(key, &spec);
+  const toml::node* node = typed(key, &spec);
   if (!node) return fallback;
-  const auto v = node->value<double>();  // accepts integers too
-  if (!v || !(node->is_floating_point() || node->is_integer())) {
-    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
-    return fallback;
-  }
-  return in_range(*spec, *v, key, *node) ? *v : fallback;
+  const double v = *node->value<double>();  // integers too
+  return in_range(*spec, v, key, *node) ? v : fallback;
 }
 
 std::string TableReader::string(std::string_view key, std::string fallback) {
   const KeySpec* spec;
-  const toml::node* node = present(key, &spec);
-  if (!node) return fallback;
-  if (!node->is_string()) {
-    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
-    return fallback;
-  }
-  return node->as_string()->get();
+  const toml::node* node = typed(key, &spec);
+  return node ? node->as_string()->get() : fallback;
 }
 
 std::string TableReader::choice(std::string_view key, const std::vector<std::string_view>& allowed,
@@ -142,56 +155,43 @@ std::string TableReader::choice(std::string_view key, const std::vector<std::str
 
 bool TableReader::boolean(std::string_view key, bool fallback) {
   const KeySpec* spec;
-  const toml::node* node = present(key, &spec);
-  if (!node) return fallback;
-  if (!node->is_boolean()) {
-    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
-    return fallback;
-  }
-  return node->as_boolean()->get();
+  const toml::node* node = typed(key, &spec);
+  return node ? node->as_boolean()->get() : fallback;
 }
 
 std::vector<double> TableReader::numbers(std::string_view key) {
   const KeySpec* spec;
-  const toml::node* node = present(key, &spec);
+  const toml::node* node = typed(key, &spec);
   if (!node) return {};
-  const toml::array* arr = node->as_array();
-  if (!arr) {
-    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
-    return {};
-  }
-  if (spec->array_size && arr->size() != spec->array_size) {
+  const toml::array& arr = *node->as_array();
+  if (spec->array_size && arr.size() != spec->array_size) {
     errors_.add(file_, node->source(), path(key),
-                fmt::format("expected {} numbers, found {}", spec->array_size, arr->size()));
+                fmt::format("expected {} numbers, found {}", spec->array_size, arr.size()));
     return {};
   }
   std::vector<double> out;
-  for (std::size_t i = 0; i < arr->size(); ++i) {
-    const toml::node& item = *arr->get(i);
-    const auto v = item.value<double>();
+  for (std::size_t i = 0; i < arr.size(); ++i) {
+    const toml::node& item = *arr.get(i);
     const std::string item_key = fmt::format("{}[{}]", key, i);
-    if (!v || !(item.is_floating_point() || item.is_integer())) {
+    if (!has_type(item, ValueType::Float)) {
       errors_.add(file_, item.source(), path(item_key), "expected a number");
       return {};
     }
-    if (!in_range(*spec, *v, item_key, item)) return {};
-    out.push_back(*v);
+    const double v = *item.value<double>();
+    if (!in_range(*spec, v, item_key, item)) return {};
+    out.push_back(v);
   }
   return out;
 }
 
 std::vector<std::string> TableReader::strings(std::string_view key) {
   const KeySpec* spec;
-  const toml::node* node = present(key, &spec);
+  const toml::node* node = typed(key, &spec);
   if (!node) return {};
-  const toml::array* arr = node->as_array();
-  if (!arr) {
-    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
-    return {};
-  }
   std::vector<std::string> out;
-  for (std::size_t i = 0; i < arr->size(); ++i) {
-    const toml::node& item = *arr->get(i);
+  const toml::array& arr = *node->as_array();
+  for (std::size_t i = 0; i < arr.size(); ++i) {
+    const toml::node& item = *arr.get(i);
     if (!item.is_string()) {
       errors_.add(file_, item.source(), path(fmt::format("{}[{}]", key, i)), "expected a string");
       return {};
@@ -203,13 +203,8 @@ std::vector<std::string> TableReader::strings(std::string_view key) {
 
 const toml::table* TableReader::table(std::string_view key) {
   const KeySpec* spec;
-  const toml::node* node = present(key, &spec);
-  if (!node) return nullptr;
-  if (!node->is_table()) {
-    errors_.add(file_, node->source(), path(key), wrong_type(*spec, *node));
-    return nullptr;
-  }
-  return node->as_table();
+  const toml::node* node = typed(key, &spec);
+  return node ? node->as_table() : nullptr;
 }
 
 std::string schema_markdown(const std::vector<const TableSpec*>& tables) {

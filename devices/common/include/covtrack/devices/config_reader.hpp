@@ -75,6 +75,7 @@ class TableReader {
  private:
   const KeySpec* spec_of(std::string_view key);
   const toml::node* present(std::string_view key, const KeySpec** spec);
+  const toml::node* typed(std::string_view key, const KeySpec** spec);
   bool in_range(const KeySpec& spec, double value, std::string_view key, const toml::node& node);
 
   const toml::table& table_;
