@@ -7,7 +7,8 @@ build_dir=${1:-build}
 
 packages=(build-essential cmake pkg-config liblcm-dev liblcm-bin libeigen3-dev
           libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev
-          libgtest-dev libgmock-dev libbenchmark-dev iproute2 util-linux)
+          libgtest-dev libgmock-dev libbenchmark-dev libopencv-core-dev libopencv-imgproc-dev
+          iproute2 util-linux)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -17,6 +17,7 @@ const char* to_string(ValueType type) {
     case ValueType::FloatArray: return "array of numbers";
     case ValueType::StringArray: return "array of strings";
     case ValueType::Table: return "table";
+    case ValueType::TableArray: return "array of tables";
   }
   return "?";
 }
@@ -102,7 +103,8 @@ bool has_type(const toml::node& node, ValueType type) {
     case ValueType::String: return node.is_string();
     case ValueType::Boolean: return node.is_boolean();
     case ValueType::FloatArray:
-    case ValueType::StringArray: return node.is_array();
+    case ValueType::StringArray:
+    case ValueType::TableArray: return node.is_array();
     case ValueType::Table: return node.is_table();
   }
   return false;
@@ -205,6 +207,23 @@ const toml::table* TableReader::table(std::string_view key) {
   const KeySpec* spec;
   const toml::node* node = typed(key, &spec);
   return node ? node->as_table() : nullptr;
+}
+
+std::vector<const toml::table*> TableReader::tables(std::string_view key) {
+  const KeySpec* spec;
+  const toml::node* node = typed(key, &spec);
+  if (!node) return {};
+  std::vector<const toml::table*> out;
+  const toml::array& arr = *node->as_array();
+  for (std::size_t i = 0; i < arr.size(); ++i) {
+    const toml::node& item = *arr.get(i);
+    if (!item.is_table()) {
+      errors_.add(file_, item.source(), path(fmt::format("{}[{}]", key, i)), "expected a table");
+      return {};
+    }
+    out.push_back(item.as_table());
+  }
+  return out;
 }
 
 std::string schema_markdown(const std::vector<const TableSpec*>& tables) {

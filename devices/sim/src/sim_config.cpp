@@ -2,9 +2,9 @@
 
 #include <fmt/format.h>
 
+#include "covtrack/devices/covariance_keys.hpp"
 #include "covtrack/devices/device_keys.hpp"
 #include "covtrack/protocol/channels.hpp"
-#include "covtrack/protocol/covariance_check.hpp"
 
 namespace covtrack::sim {
 
@@ -15,12 +15,6 @@ const TableSpec& sim_device_spec() {
         {"sensors", ValueType::StringArray, "", "", "sensor names (child frames); or sensor_count"},
         {"sensor_count", ValueType::Integer, "", "", "N sensors named s0..s(N-1); or sensors", 1, 64},
         {"rate_hz", ValueType::Float, "Hz", "100", "reports per second per sensor", 0.01, 10000},
-        {"sigma_m", ValueType::FloatArray, "m", "", "1-sigma position noise x y z (body frame); "
-         "with sigma_rad, or give covariance", 0, 10, 3},
-        {"sigma_rad", ValueType::FloatArray, "rad", "", "1-sigma rotation noise about x y z "
-         "(body frame)", 0, 3.2, 3},
-        {"covariance", ValueType::FloatArray, "m^2, m*rad, rad^2", "",
-         "full 6x6 row-major, BODY convention; instead of sigma_m and sigma_rad", -100, 100, 36},
         {"seed", ValueType::Integer, "", "1", "noise seed: same seed, same noise", 0, 4e18},
         {"dropout_every_s", ValueType::Float, "s", "0", "a LOST interval ends every this many "
          "seconds (0: never)", 0, 1e6},
@@ -31,6 +25,8 @@ const TableSpec& sim_device_spec() {
         {"motion", ValueType::Table, "", "circle", "how the sensors move: see devices.<name>.motion"},
     };
     s.keys.insert(s.keys.end(), own.begin(), own.end());
+    const auto cov = covariance_keys();  // the noise is drawn from exactly this covariance
+    s.keys.insert(s.keys.end(), cov.begin(), cov.end());
     return s;
   }();
   return spec;
@@ -95,36 +91,6 @@ MotionConfig read_motion(TableReader& device) {
   return m;
 }
 
-Mat6 read_covariance(TableReader& r) {
-  const bool full = r.has("covariance");
-  const bool sigmas = r.has("sigma_m") || r.has("sigma_rad");
-  if (full == sigmas) {
-    r.error(full ? "covariance" : "sigma_m",
-            "give either covariance (6x6) or both sigma_m and sigma_rad, not both or neither");
-    return Mat6::Identity() * 1e-6;
-  }
-  Mat6 cov = Mat6::Zero();
-  if (full) {
-    const auto v = r.numbers("covariance");
-    if (v.size() != 36) return Mat6::Identity() * 1e-6;
-    cov = Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(v.data());
-    if (const auto problem = check_covariance(cov))
-      r.error("covariance", fmt::format("{}: {}", to_string(problem->defect), problem->detail));
-    return cov;
-  }
-  if (!r.has("sigma_m") || !r.has("sigma_rad")) {
-    r.error(r.has("sigma_m") ? "sigma_m" : "sigma_rad", "both sigma_m and sigma_rad are needed");
-    return Mat6::Identity() * 1e-6;
-  }
-  const auto sm = r.numbers("sigma_m");
-  const auto sr = r.numbers("sigma_rad");
-  if (sm.size() != 3 || sr.size() != 3) return Mat6::Identity() * 1e-6;  // already reported
-  for (int i = 0; i < 3; ++i) {
-    cov(i, i) = sm[i] * sm[i];
-    cov(i + 3, i + 3) = sr[i] * sr[i];
-  }
-  return cov;
-}
 }  // namespace
 
 SimConfig read_sim_config(TableReader& r, const std::string& device_name) {

@@ -13,7 +13,7 @@
 
 namespace covtrack {
 
-enum class ValueType { Integer, Float, String, Boolean, FloatArray, StringArray, Table };
+enum class ValueType { Integer, Float, String, Boolean, FloatArray, StringArray, Table, TableArray };
 const char* to_string(ValueType type);
 
 struct KeySpec {
@@ -65,6 +65,8 @@ class TableReader {
   std::vector<std::string> strings(std::string_view key);
   // A sub-table, or nullptr if absent (an error if required or of the wrong type).
   const toml::table* table(std::string_view key);
+  // An array of tables ([[key]] in TOML): each element checked to be a table.
+  std::vector<const toml::table*> tables(std::string_view key);
 
   // Records a problem that only the caller can judge (e.g. two keys that conflict).
   void error(std::string_view key, const std::string& message);
