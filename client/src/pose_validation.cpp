@@ -7,14 +7,19 @@
 namespace covtrack::client {
 namespace {
 constexpr double kQuaternionNormTolerance = 1e-6;
+
+bool finite_position(const pose_cov_t& msg) {
+  for (double v : msg.position_m)
+    if (!std::isfinite(v)) return false;
+  return true;
 }
+}  // namespace
 
 std::optional<std::string> rejection_reason(const pose_cov_t& msg) {
   if (msg.status < pose_cov_t::STATUS_OK || msg.status > pose_cov_t::STATUS_LOST)
     return "unknown status " + std::to_string(msg.status);
   if (msg.status == pose_cov_t::STATUS_LOST) return std::nullopt;
-  for (double v : msg.position_m)
-    if (!std::isfinite(v)) return "non-finite position";
+  if (!finite_position(msg)) return "non-finite position";
   if (!(quaternion_norm_error(msg) <= kQuaternionNormTolerance))
     return "quaternion is not of unit norm";
   if (msg.covariance_convention < pose_cov_t::CONVENTION_BODY ||
@@ -32,8 +37,18 @@ TrackedTransform to_tracked_transform(const pose_cov_t& msg, std::int64_t receiv
   t.parent_frame = msg.parent_frame;
   t.child_frame = msg.child_frame;
   t.status = static_cast<TrackingStatus>(msg.status);
-  t.T_parent_child = pose_of(msg);
-  t.covariance = t.lost() ? Mat6::Identity() * INFINITY : body_covariance_of(msg);
+  // A LOST message's pose is not checked and may hold a zero quaternion or NaNs: keep
+  // identity then rather than propagating NaNs into the transform graph.
+  const bool usable_pose =
+      !t.lost() || (finite_position(msg) && quaternion_norm_error(msg) <= kQuaternionNormTolerance);
+  if (usable_pose) t.T_parent_child = pose_of(msg);
+  if (t.lost()) {
+    // Infinite uncertainty; Identity() * INFINITY would put NaN (0 * inf) off the diagonal.
+    t.covariance = Mat6::Zero();
+    t.covariance.diagonal().setConstant(INFINITY);
+  } else {
+    t.covariance = body_covariance_of(msg);
+  }
   t.measurement_time_us = msg.measurement_time_us;
   t.publish_time_us = msg.publish_time_us;
   t.receive_time_us = receive_time_us;

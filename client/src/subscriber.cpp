@@ -18,36 +18,63 @@ namespace covtrack::client {
 namespace {
 // How often, at the least, the dispatch thread wakes to mark streams stale.
 constexpr int kStaleCheckMs = 20;
+// Heartbeats come once per second per device; this only absorbs a burst at start-up.
+constexpr int kStatusQueueCapacity = 1000;
 
+// POSIX extended syntax: the same dialect LCM's own channel regex (regcomp) uses.
 Result<std::regex> compile(const std::string& pattern) {
   try {
-    return std::regex(pattern, std::regex::extended);
+    return std::regex(pattern, std::regex::extended | std::regex::optimize);
   } catch (const std::regex_error& e) {
     return fail("bad stream pattern '" + pattern + "': " + e.what());
   }
+}
+
+struct Callback {
+  std::regex pattern;
+  Subscriber::PoseCallback function;
+};
+// Replaced, never modified, so the dispatch thread can call a snapshot without a lock.
+using CallbackList = std::vector<Callback>;
+
+// Counts the sequence numbers skipped before `sequence`. A sequence going backwards is a
+// daemon restart (it starts again at 0): the count restarts, it is no loss.
+std::int64_t skipped_before(std::int64_t last_sequence, std::int64_t sequence) {
+  if (last_sequence < 0 || sequence <= last_sequence) return 0;
+  return sequence - last_sequence - 1;
 }
 }  // namespace
 
 struct Subscriber::Impl {
   SubscriberOptions options;
-  std::unique_ptr<lcm::LCM> lcm;
+  std::shared_ptr<lcm::LCM> lcm;
+  std::vector<lcm::Subscription*> subscriptions;
   int wake_fd = -1;
   std::jthread thread;
 
-  mutable std::mutex mutex;
+  mutable std::mutex mutex;  // guards streams and statuses
   struct Stream {
     StreamState state;
-    std::int64_t last_sequence = -1;
-    std::int64_t last_receive_us = 0;
+    std::int64_t last_sequence = -1;  // of the last decoded message, accepted or not
+    std::int64_t last_accept_us = 0;
+    // The callbacks whose pattern matches this stream, for `matched_for`: regex matching
+    // once per stream and callback list, not once per message.
+    std::shared_ptr<const CallbackList> matched_for;
+    std::vector<const Subscriber::PoseCallback*> matched;
   };
   std::map<std::string, Stream> streams;  // by "device/sensor"
   std::map<std::string, device_status_t> statuses;
 
   std::mutex callbacks_mutex;
-  std::vector<std::pair<std::regex, PoseCallback>> callbacks;
+  std::shared_ptr<const CallbackList> callbacks = std::make_shared<CallbackList>();
 
   ~Impl() {
     if (wake_fd >= 0) ::close(wake_fd);
+  }
+
+  std::shared_ptr<const CallbackList> callback_snapshot() {
+    std::lock_guard lock(callbacks_mutex);
+    return callbacks;
   }
 
   void on_pose_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
@@ -55,38 +82,50 @@ struct Subscriber::Impl {
     const auto id = parse_pose_channel(channel);
     if (!id) return;  // matched the regex but is not a well-formed stream name
     pose_cov_t msg;
+    const bool decoded = msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) >= 0;
+    // Only a message that names this stream tells anything about its sequence numbers.
+    const bool ours = decoded && msg.device == id->device && msg.sensor == id->sensor;
     std::optional<std::string> reason;
-    if (msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0)
+    if (!decoded)
       reason = "malformed message (" + std::to_string(rbuf->data_size) + " bytes)";
-    else if (msg.device != id->device || msg.sensor != id->sensor)
+    else if (!ours)
       reason = "device/sensor '" + msg.device + "/" + msg.sensor + "' differ from the channel";
     else
       reason = rejection_reason(msg);
 
+    const auto current_callbacks = callback_snapshot();
     std::optional<TrackedTransform> accepted;
+    std::vector<const PoseCallback*> to_call;
     {
       std::lock_guard lock(mutex);
       Stream& s = streams[id->key()];
       s.state.id = *id;
+      // A rejected message still arrived: its sequence number is no loss.
+      if (ours) {
+        s.state.counters.lost += skipped_before(s.last_sequence, msg.sequence);
+        s.last_sequence = msg.sequence;
+      }
       if (reason) {
         ++s.state.counters.rejected;
         s.state.last_rejection = *reason;
         return;
       }
-      // A sequence going backwards is a daemon restart, not a loss.
-      if (s.last_sequence >= 0 && msg.sequence > s.last_sequence + 1)
-        s.state.counters.lost += msg.sequence - s.last_sequence - 1;
-      s.last_sequence = msg.sequence;
-      s.last_receive_us = now;
+      s.last_accept_us = now;
       s.state.stale = false;
       ++s.state.counters.received;
       s.state.latest = to_tracked_transform(msg, now);
       accepted = s.state.latest;
+      if (s.matched_for != current_callbacks) {
+        s.matched.clear();
+        for (const auto& cb : *current_callbacks)
+          if (std::regex_match(id->key(), cb.pattern)) s.matched.push_back(&cb.function);
+        s.matched_for = current_callbacks;
+      }
+      to_call = s.matched;
     }
-    std::lock_guard lock(callbacks_mutex);
-    const std::string key = id->key();
-    for (auto& [re, cb] : callbacks)
-      if (std::regex_match(key, re)) cb(*accepted);
+    // Outside the lock: a callback may read latest() or register another callback.
+    // current_callbacks keeps the functions alive while they run.
+    for (const PoseCallback* cb : to_call) (*cb)(*accepted);
   }
 
   void on_status(const lcm::ReceiveBuffer*, const std::string&, const device_status_t* msg) {
@@ -98,19 +137,25 @@ struct Subscriber::Impl {
     const std::int64_t limit = now_us() - static_cast<std::int64_t>(options.stale_after_s * 1e6);
     std::lock_guard lock(mutex);
     for (auto& [key, s] : streams)
-      if (!s.state.stale && s.last_receive_us > 0 && s.last_receive_us < limit) {
+      if (!s.state.stale && s.last_accept_us > 0 && s.last_accept_us < limit) {
         s.state.stale = true;
         ++s.state.counters.stale;
       }
   }
 
-  // LCM's handle() cannot be interrupted: poll its descriptor together with wake_fd.
+  // LCM's handle() cannot be interrupted: poll its descriptor together with wake_fd,
+  // which stop() writes to.
   void dispatch(std::stop_token stop) {
     pollfd fds[2] = {{lcm->getFileno(), POLLIN, 0}, {wake_fd, POLLIN, 0}};
+    std::int64_t next_stale_check = 0;
     while (!stop.stop_requested()) {
       const int n = ::poll(fds, 2, kStaleCheckMs);
       if (n > 0 && (fds[0].revents & POLLIN)) lcm->handle();
-      mark_stale();
+      // At high rates poll() never times out: check staleness on a clock, not per wake-up.
+      if (const std::int64_t now = now_us(); now >= next_stale_check) {
+        mark_stale();
+        next_stale_check = now + kStaleCheckMs * 1000;
+      }
     }
   }
 };
@@ -123,18 +168,27 @@ Result<std::unique_ptr<Subscriber>> Subscriber::open(const SubscriberOptions& op
   if (auto re = compile(options.pattern); !re) return std::unexpected(re.error());
   auto lcm = open_lcm(options.lcm_url);
   if (!lcm) return std::unexpected(lcm.error());
+  return attach(std::shared_ptr<lcm::LCM>(std::move(*lcm)), options);
+}
+
+Result<std::unique_ptr<Subscriber>> Subscriber::attach(std::shared_ptr<lcm::LCM> lcm,
+                                                       const SubscriberOptions& options) {
+  if (auto re = compile(options.pattern); !re) return std::unexpected(re.error());
+  if (!lcm || !lcm->good()) return fail("Subscriber::attach: the LCM instance is not usable");
   auto impl = std::make_unique<Impl>();
   impl->options = options;
-  impl->lcm = std::move(*lcm);
+  impl->lcm = std::move(lcm);
   impl->wake_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
-  if (impl->wake_fd < 0) return fail("eventfd failed");
+  if (impl->wake_fd < 0) return fail("Subscriber: eventfd failed");
 
   Impl* raw = impl.get();
+  // LCM anchors a subscription's regex at both ends: "whole match" comes for free.
   auto* poses = raw->lcm->subscribe(std::string(kPosePrefix) + "(" + options.pattern + ")",
                                     &Impl::on_pose_bytes, raw);
   poses->setQueueCapacity(options.queue_capacity);
   auto* status = raw->lcm->subscribe(std::string(kStatusPrefix) + ".*", &Impl::on_status, raw);
-  status->setQueueCapacity(1000);
+  status->setQueueCapacity(kStatusQueueCapacity);
+  raw->subscriptions = {poses, status};
   raw->thread = std::jthread([raw](std::stop_token stop) { raw->dispatch(stop); });
   return std::unique_ptr<Subscriber>(new Subscriber(std::move(impl)));
 }
@@ -143,7 +197,9 @@ Result<void> Subscriber::on_pose(const std::string& pattern, PoseCallback callba
   auto re = compile(pattern);
   if (!re) return std::unexpected(re.error());
   std::lock_guard lock(impl_->callbacks_mutex);
-  impl_->callbacks.emplace_back(std::move(*re), std::move(callback));
+  auto next = std::make_shared<CallbackList>(*impl_->callbacks);
+  next->push_back({std::move(*re), std::move(callback)});
+  impl_->callbacks = std::move(next);
   return {};
 }
 
@@ -164,6 +220,7 @@ std::optional<StreamState> Subscriber::stream(const StreamId& id) const {
 std::vector<StreamState> Subscriber::streams() const {
   std::lock_guard lock(impl_->mutex);
   std::vector<StreamState> out;
+  out.reserve(impl_->streams.size());
   for (const auto& [key, s] : impl_->streams) out.push_back(s.state);
   return out;
 }
@@ -179,6 +236,9 @@ void Subscriber::stop() {
   const std::uint64_t one = 1;
   [[maybe_unused]] auto n = ::write(impl_->wake_fd, &one, sizeof one);
   impl_->thread.join();
+  // A shared instance outlives us: it must not call back into a destroyed Impl.
+  for (auto* s : impl_->subscriptions) impl_->lcm->unsubscribe(s);
+  impl_->subscriptions.clear();
 }
 
 }  // namespace covtrack::client

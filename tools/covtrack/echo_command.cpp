@@ -5,9 +5,9 @@
 #include <Eigen/Eigenvalues>
 #include <chrono>
 #include <cmath>
+#include <atomic>
 #include <iostream>
 #include <map>
-#include <mutex>
 #include <numbers>
 #include <thread>
 
@@ -36,7 +36,8 @@ double worst_sigma(const Mat6& cov, int block) {
 }
 
 nlohmann::json to_json(const client::TrackedTransform& t) {
-  const Eigen::Quaterniond q(t.T_parent_child.linear());
+  Eigen::Quaterniond q(t.T_parent_child.linear());
+  if (q.w() < 0) q.coeffs() = -q.coeffs();  // the wire's canonical sign
   nlohmann::json j = {
       {"device", t.stream.device}, {"sensor", t.stream.sensor},
       {"parent_frame", t.parent_frame}, {"child_frame", t.child_frame},
@@ -50,23 +51,44 @@ nlohmann::json to_json(const client::TrackedTransform& t) {
   if (t.lost()) {
     j["covariance"] = nullptr;  // infinite: JSON has no infinity
   } else {
-    std::vector<double> c(t.covariance.data(), t.covariance.data() + 36);  // symmetric
+    std::vector<double> c;  // row-major, as on the wire
+    for (int r = 0; r < 6; ++r)
+      for (int k = 0; k < 6; ++k) c.push_back(t.covariance(r, k));
     j["covariance"] = c;
   }
   return j;
 }
 
-std::string table(const client::Subscriber& sub, std::map<std::string, std::pair<long, double>>& rates) {
-  std::string out = fmt::format("{:<28} {:>8} {:>27} {:>10} {:>9} {:<9} {:>6} {:>6}\n", "stream",
-                                "rate Hz", "position m", "σpos mm", "σrot deg", "status", "lost",
-                                "reject");
-  const auto now = std::chrono::steady_clock::now().time_since_epoch();
-  const double now_s = std::chrono::duration<double>(now).count();
-  for (const auto& s : sub.streams()) {
-    auto& [last_count, last_time] = rates[s.id.key()];
-    const double rate = last_time > 0 ? (s.counters.received - last_count) / (now_s - last_time) : 0;
-    last_count = s.counters.received;
+// Rate per stream from the change of its received counter between two tables.
+class RateMeter {
+ public:
+  explicit RateMeter(double start_s) : start_s_(start_s) {}
+  double update(const std::string& key, std::int64_t received, double now_s) {
+    // A stream first seen now started counting when echo started.
+    auto& [last_count, last_time] = last_.try_emplace(key, 0, start_s_).first->second;
+    const double rate = now_s > last_time ? (received - last_count) / (now_s - last_time) : 0;
+    last_count = received;
     last_time = now_s;
+    return rate;
+  }
+
+ private:
+  double start_s_;
+  std::map<std::string, std::pair<std::int64_t, double>> last_;
+};
+
+constexpr const char* kRowFormat = "{:<28} {:>8} {:>26} {:>9} {:>9} {:<8} {:>6} {:>6} {:<5} {:>5}\n";
+
+double steady_now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string table(const client::Subscriber& sub, RateMeter& rates) {
+  std::string out = fmt::format(fmt::runtime(kRowFormat), "stream", "rate Hz", "position m (x y z)",
+                                "σpos mm", "σrot deg", "status", "lost", "reject", "stale", "times");
+  const double now_s = steady_now_s();
+  for (const auto& s : sub.streams()) {
+    const double rate = rates.update(s.id.key(), s.counters.received, now_s);
     std::string position = "-", sp = "-", sr = "-", status = "-";
     if (s.latest) {
       const Vec3 p = s.latest->T_parent_child.translation();
@@ -75,19 +97,24 @@ std::string table(const client::Subscriber& sub, std::map<std::string, std::pair
       if (!s.latest->lost()) {
         sp = fmt::format("{:.3f}", 1e3 * worst_sigma(s.latest->covariance, 0));
         sr = fmt::format("{:.3f}", worst_sigma(s.latest->covariance, 1) * 180 / std::numbers::pi);
+      } else {
+        sp = sr = "inf";
       }
     }
-    if (s.stale) status = "STALE";
-    out += fmt::format("{:<28} {:>8.1f} {:>27} {:>10} {:>9} {:<9} {:>6} {:>6}\n", s.id.key(), rate,
-                       position, sp, sr, status, s.counters.lost, s.counters.rejected);
+    out += fmt::format(fmt::runtime(kRowFormat), s.id.key(), fmt::format("{:.1f}", rate), position, sp,
+                       sr, status, s.counters.lost, s.counters.rejected, s.stale ? "STALE" : "",
+                       s.counters.stale);
   }
+  out += "σ: 1-sigma along the worst direction (sqrt of the largest eigenvalue of the 3x3 "
+         "position / rotation block, BODY frame); stale times: how often it went stale\n";
   for (const auto& [device, st] : sub.device_statuses())
-    out += fmt::format("device {:<20} reports {:>9} errors {:>4} drops {:>4} restarts {:>3}{}\n",
-                       device, st.reports, st.errors, st.drops, st.restarts,
+    out += fmt::format("device {:<20} {:>7.1f} Hz reports {:>9} errors {:>4} drops {:>4} restarts {:>3}{}\n",
+                       device, st.rate_hz, st.reports, st.errors, st.drops, st.restarts,
                        st.last_error.empty() ? "" : "  last error: " + st.last_error);
   return out;
 }
 
+// Ends on SIGINT/SIGTERM, --count messages or --duration seconds.
 int run_echo(const EchoOptions& o) {
   install_stop_signals();
   auto sub = client::Subscriber::open(o.subscriber);
@@ -95,30 +122,30 @@ int run_echo(const EchoOptions& o) {
     std::cerr << "covtrack echo: " << sub.error().message << "\n";
     return 1;
   }
-  std::atomic<long> printed{0};
-  std::mutex out_mutex;
-  if (o.json) {
-    (void)(*sub)->on_pose(".*", [&](const client::TrackedTransform& t) {
-      if (o.count > 0 && printed >= o.count) return;
-      std::lock_guard lock(out_mutex);
-      std::cout << to_json(t).dump() << "\n" << std::flush;
-      ++printed;
-    });
-  }
+  std::atomic<long> seen{0};
+  // Runs on the subscriber's dispatch thread, the only writer of stdout in --json mode.
+  (void)(*sub)->on_pose(".*", [&](const client::TrackedTransform& t) {
+    if (o.count > 0 && seen >= o.count) return;
+    if (o.json) std::cout << to_json(t).dump() << "\n" << std::flush;
+    ++seen;
+  });
   const bool tty = ::isatty(STDOUT_FILENO);
   const auto start = std::chrono::steady_clock::now();
-  auto next_table = start;
-  std::map<std::string, std::pair<long, double>> rates;
+  auto next_table = start + std::chrono::milliseconds(tty ? 200 : 1000);
+  RateMeter rates(steady_now_s());
+  auto print_table = [&] {
+    const std::string t = table(**sub, rates);
+    if (tty) std::cout << "\x1b[H\x1b[2J";  // redraw in place
+    std::cout << t << (tty ? "" : "\n") << std::flush;
+  };
   while (!stop_requested()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     const auto now = std::chrono::steady_clock::now();
-    if (o.count > 0 && printed >= o.count) break;
+    if (o.count > 0 && seen >= o.count) break;
     if (o.duration_s > 0 && now - start >= std::chrono::duration<double>(o.duration_s)) break;
     if (!o.json && now >= next_table) {
-      next_table = now + std::chrono::milliseconds(tty ? 200 : 1000);
-      const std::string t = table(**sub, rates);
-      if (tty) std::cout << "\x1b[H\x1b[2J";  // redraw in place
-      std::cout << t << (tty ? "" : "\n") << std::flush;
+      next_table += std::chrono::milliseconds(tty ? 200 : 1000);
+      print_table();
     }
   }
   (*sub)->stop();
@@ -136,7 +163,7 @@ void add_echo_command(CLI::App& app) {
   cmd->add_option("--lcm-url", o->subscriber.lcm_url, "LCM URL");
   cmd->add_option("--stale", o->subscriber.stale_after_s, "seconds without a message before a stream is stale")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--count", o->count, "exit after this many messages (with --json)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--count", o->count, "exit after this many accepted messages")->check(CLI::NonNegativeNumber);
   cmd->add_option("--duration", o->duration_s, "exit after this many seconds")->check(CLI::NonNegativeNumber);
   cmd->callback([o] {
     if (const int rc = run_echo(*o); rc != 0) throw CLI::RuntimeError(rc);

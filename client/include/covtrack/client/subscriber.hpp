@@ -1,9 +1,22 @@
 #pragma once
 // Receives covtrack pose streams and device heartbeats on one LCM dispatch thread.
 //
-// Thread safety: every const method may be called from any thread. Callbacks run on the
-// dispatch thread, one at a time, and must return quickly (they delay every stream).
-// A callback must not call stop() or destroy the Subscriber.
+//   auto sub = covtrack::client::Subscriber::open({.lcm_url = url, .pattern = "sim/.*"});
+//   if (!sub) { report(sub.error().message); return; }
+//   (*sub)->on_pose(".*", [](const TrackedTransform& t) { ... });   // dispatch thread
+//   auto head = (*sub)->latest({"sim", "head"});                        // any thread
+//
+// Thread safety: every const method, on_pose() and stop() may be called from any thread.
+// Callbacks run on the dispatch thread, one at a time, in arrival order; they must return
+// quickly (they delay every stream) and must not throw (an exception escaping a callback
+// ends the process). A callback may call on_pose() and the const methods, but not stop()
+// nor destroy the Subscriber.
+//
+// What is delivered: a message is rejected (counted, never passed to latest() or a
+// callback) when it cannot be decoded, names another device/sensor than its channel,
+// has an unknown status or convention, a non-finite position, a non-unit quaternion or
+// a covariance that is non-finite, asymmetric or not positive semi-definite. LOST
+// messages skip the covariance checks: see TrackedTransform.
 #include <functional>
 #include <map>
 #include <memory>
@@ -12,6 +25,7 @@
 #include <vector>
 
 #include <covtrack/device_status_t.hpp>
+#include <lcm/lcm-cpp.hpp>
 
 #include "covtrack/client/tracked_transform.hpp"
 #include "covtrack/protocol/result.hpp"
@@ -19,26 +33,26 @@
 namespace covtrack::client {
 
 struct SubscriberOptions {
-  std::string lcm_url;           // empty: $LCM_DEFAULT_URL, else LCM's default
-  std::string pattern = ".*";    // regular expression over "device/sensor", whole match
+  std::string lcm_url = {};      // empty: $LCM_DEFAULT_URL, else LCM's default
+  std::string pattern = ".*";    // POSIX extended regex over "device/sensor", whole match
   double stale_after_s = 0.5;    // a stream is stale after this long without a message
   // LCM drops the newest message silently when a subscription's queue is full (default
-  // 30); this is that queue's length.
+  // 30); this is that queue's length, large enough for a burst of several seconds.
   int queue_capacity = 100000;
 };
 
 struct StreamCounters {
   std::int64_t received = 0;  // accepted messages
-  std::int64_t lost = 0;      // missing sequence numbers
+  std::int64_t lost = 0;      // sequence numbers skipped (a sequence going back = restart, not loss)
   std::int64_t rejected = 0;  // malformed or invalid messages (never delivered)
   std::int64_t stale = 0;     // times the stream went stale
 };
 
 struct StreamState {
   StreamId id;
-  std::optional<TrackedTransform> latest;
+  std::optional<TrackedTransform> latest;  // the last accepted message
   StreamCounters counters;
-  bool stale = false;
+  bool stale = false;          // no accepted message for stale_after_s (checked every ~20 ms)
   std::string last_rejection;  // why the last rejected message was rejected
 };
 
@@ -46,23 +60,33 @@ class Subscriber {
  public:
   using PoseCallback = std::function<void(const TrackedTransform&)>;
 
-  // Fails at once, with how to fix it, on an unusable URL or a bad pattern.
+  // Opens its own LCM instance. Fails at once, with how to fix it, on an unusable URL
+  // (no multicast route: no 10 s LCM self-test hang) or a bad pattern.
   static Result<std::unique_ptr<Subscriber>> open(const SubscriberOptions& options);
+
+  // Receives on an LCM instance the caller shares, e.g. one memq:// instance that the
+  // same process publishes on (memq only reaches its own instance). options.lcm_url is
+  // ignored. The Subscriber's thread is then the only one that may call handle() on it,
+  // and only one Subscriber may attach to an instance.
+  static Result<std::unique_ptr<Subscriber>> attach(std::shared_ptr<lcm::LCM> lcm,
+                                                    const SubscriberOptions& options);
   ~Subscriber();
   Subscriber(const Subscriber&) = delete;
   Subscriber& operator=(const Subscriber&) = delete;
 
-  // Calls `callback` for every accepted message of the streams whose "device/sensor"
-  // matches `pattern` (a subset of the subscriber's own pattern). Returns an error for a
-  // bad regular expression.
+  // Calls `callback` on the dispatch thread for every accepted message of the streams
+  // whose "device/sensor" wholly matches `pattern` (only streams the subscriber's own
+  // pattern lets in ever arrive). Returns an error for a bad regular expression.
   Result<void> on_pose(const std::string& pattern, PoseCallback callback);
 
   std::optional<TrackedTransform> latest(const StreamId& id) const;
-  std::optional<StreamState> stream(const StreamId& id) const;
+  std::optional<StreamState> stream(const StreamId& id) const;  // nothing if never seen
   std::vector<StreamState> streams() const;  // ordered by device/sensor
+  // The last heartbeat (covtrack/status/<device>) of each device, by device name.
   std::map<std::string, device_status_t> device_statuses() const;
 
-  // Ends the dispatch thread; idempotent, prompt even when no message arrives.
+  // Ends the dispatch thread; idempotent, prompt even when no message arrives. After it
+  // no callback runs; latest() and the counters keep their last values.
   void stop();
 
  private:

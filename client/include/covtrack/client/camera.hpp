@@ -1,0 +1,39 @@
+#pragma once
+// A pinhole camera with OpenCV's 5-coefficient distortion model (k1 k2 p1 p2 k3).
+// Camera frame as in OpenCV: looks along +z, x right, y down; pixels (u, v) from the
+// top-left corner. Loaded from the file OpenCV's calibration sample writes.
+#include <filesystem>
+
+#include <Eigen/Core>
+
+#include "covtrack/protocol/result.hpp"
+#include "covtrack/protocol/se3.hpp"
+
+namespace covtrack::client {
+
+using Vec2 = Eigen::Vector2d;
+using Mat2 = Eigen::Matrix2d;
+using Mat23 = Eigen::Matrix<double, 2, 3>;
+
+struct Camera {
+  double fx = 0, fy = 0, cx = 0, cy = 0;  // px
+  int width_px = 0, height_px = 0;
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
+  // Standard deviations of (fx, fy, cx, cy) in px; zero when the calibration gives none.
+  Eigen::Vector4d intrinsic_sigmas_px = Eigen::Vector4d::Zero();
+
+  // Pixel of a point in the camera frame (z > 0 expected; the caller checks depth).
+  // J_pixel_point, if given, receives d(pixel)/d(p_camera), exact, distortion included.
+  Vec2 project(const Vec3& p_camera, Mat23* J_pixel_point = nullptr) const;
+
+  // First-order screen covariance (px^2) due to the intrinsic sigmas, at this point.
+  Mat2 intrinsic_covariance(const Vec3& p_camera) const;
+};
+
+// Reads `camera_matrix`, `distortion_coefficients` (4 or 5 values; longer vectors only if
+// the extra terms are zero), `image_width`, `image_height`, and the optional
+// `intrinsics_std_deviations` (fx fy cx cy first, as cv::calibrateCamera orders them).
+// Errors name the file and the key.
+Result<Camera> load_camera(const std::filesystem::path& file);
+
+}  // namespace covtrack::client

@@ -1,0 +1,78 @@
+#pragma once
+// Projection of an object's vertex to the screen with its 2x2 pixel covariance, given the
+// uncertain pose T_camera_object in the BODY convention: T_true = T * Exp(xi),
+// xi ~ N(0, C), xi = [translation, rotation] (protocol/README.md).
+//
+// Two methods: the unscented transform over xi (seed appendix A; the default) and the
+// first-order linearisation (the fast path). Problems are reported in flags, never hidden.
+#include <numbers>
+#include <span>
+#include <vector>
+
+#include "covtrack/client/camera.hpp"
+#include "covtrack/client/uncertain_pose.hpp"
+
+namespace covtrack::client {
+
+using Mat26 = Eigen::Matrix<double, 2, 6>;
+
+// Scaled unscented transform (Julier): lambda = alpha^2 (n + kappa) - n, n = 6.
+// The defaults (alpha 1, beta 0, kappa 3 - n) are the seed's plain UT: W0 = kappa/(n+kappa).
+struct UnscentedParams {
+  double alpha = 1.0;
+  double beta = 0.0;
+  double kappa = 3.0 - 6.0;
+};
+
+enum class ProjectionMethod { unscented, linear };
+
+struct ProjectionOptions {
+  ProjectionMethod method = ProjectionMethod::unscented;
+  UnscentedParams unscented;
+  // Points closer than this (camera z, metres) have no usable pixel.
+  double near_m = 0.01;
+  // Above this rotation sigma (sqrt of the largest eigenvalue of the rotation block), a
+  // Gaussian ellipse on the screen no longer describes where the vertex can be.
+  double max_rotation_sigma_rad = 15.0 * std::numbers::pi / 180.0;
+  // Add the camera's intrinsic sigmas (first order) to the screen covariance.
+  bool add_intrinsic_uncertainty = true;
+};
+
+struct ProjectionFlags {
+  bool behind_camera = false;              // the vertex itself has z < near: no pixel
+  bool sigma_point_behind_camera = false;  // a perturbed vertex has z < near
+  bool rotation_too_uncertain = false;     // see max_rotation_sigma_rad
+  bool unbounded = false;                  // input pose is LOST: covariance meaningless
+  bool covariance_repaired = false;        // UT gave an indefinite matrix; clipped to PSD
+
+  // The mean and covariance describe the vertex (the other flags are warnings).
+  bool usable() const { return !behind_camera && !sigma_point_behind_camera && !unbounded; }
+  bool any() const {
+    return behind_camera || sigma_point_behind_camera || rotation_too_uncertain ||
+           unbounded || covariance_repaired;
+  }
+  ProjectionFlags& operator|=(const ProjectionFlags& o);
+};
+
+struct ProjectedVertex {
+  Vec2 mean_px = Vec2::Zero();
+  Mat2 covariance_px2 = Mat2::Zero();
+  double depth_m = 0;  // camera z of the unperturbed vertex
+  ProjectionFlags flags;
+};
+
+// d(pixel)/d(xi) at xi = 0 for the pixel of T * Exp(xi) * p_object; exact, analytic:
+// J_camera(p_c) * R * [I, -skew(p_object)].
+Mat26 pixel_jacobian_wrt_perturbation(const Camera& camera, const Pose& T_camera_object,
+                                      const Vec3& p_object);
+
+ProjectedVertex project_vertex(const Camera& camera, const UncertainPose& T_camera_object,
+                               const Vec3& p_object, const ProjectionOptions& options = {});
+
+// All vertices of one object; the UT sigma poses are built once and shared.
+std::vector<ProjectedVertex> project_vertices(const Camera& camera,
+                                              const UncertainPose& T_camera_object,
+                                              std::span<const Vec3> p_object,
+                                              const ProjectionOptions& options = {});
+
+}  // namespace covtrack::client

@@ -1,0 +1,85 @@
+#pragma once
+// Screen-space error regions of an object (seed 5.2-5.5).
+//
+//  - Error ellipse per vertex at a confidence p, drawn as a polygon that CONTAINS it: the
+//    image of a regular N-gon circumscribed about the unit circle (vertices at radius
+//    1/cos(pi/N)) under the ellipse's affine map. Each polygon vertex is A u / cos(pi/N)
+//    for a point A u on the ellipse, so the polygon lies within
+//        a (1/cos(pi/N) - 1)          (a = semi-major axis)
+//    of the ellipse; N is the smallest count meeting RegionOptions::max_polygon_error_px.
+//  - Outer region (expansion, 5.5.1): convex hull of all ellipse polygons. It contains
+//    every ellipse, so each vertex lies in it with probability >= p.
+//  - Inner region (contraction, 5.5.2): for each edge of the hull of the mean vertices, the
+//    line tangent to both adjacent ellipses on the interior side; the region is the
+//    intersection of the interior half-planes. Where the seed's construction (corners =
+//    intersections of consecutive tangent lines, then their hull) is well formed, the two
+//    are the same polygon; the half-plane form stays right when tangent lines become
+//    redundant or cross, and is empty when the errors swamp the object.
+// Polygons are counter-clockwise in (u, v) arithmetic (positive signed area), no repeated
+// closing vertex.
+#include <span>
+#include <vector>
+
+#include "covtrack/client/assessment.hpp"
+#include "covtrack/client/projection.hpp"
+
+namespace covtrack::client {
+
+using Polygon = std::vector<Vec2>;
+
+// ---- Polygons (region_polygon.cpp) ----
+// Andrew's monotone chain; collinear points dropped. Indices into `points`.
+std::vector<int> convex_hull_indices(std::span<const Vec2> points);
+Polygon convex_hull(std::span<const Vec2> points);
+// The part of a convex polygon with normal . x <= offset.
+Polygon clip_half_plane(const Polygon& convex, const Vec2& normal, double offset);
+// Inside or within tolerance_px of a convex polygon.
+bool polygon_contains(const Polygon& convex, const Vec2& point, double tolerance_px = 1e-9);
+double polygon_area(const Polygon& polygon);
+
+// ---- Ellipses (region_ellipse.cpp) ----
+// Smallest N in [min_sides, max_sides] with a (1/cos(pi/N) - 1) <= max_error_px.
+int circumscribed_polygon_sides(double semi_major_px, double max_error_px, int min_sides,
+                                int max_sides);
+// The ellipse {x : (x-c)^T C^-1 (x-c) <= scale^2} circumscribed by an N-gon.
+Polygon circumscribed_ellipse_polygon(const Vec2& center_px, const Mat2& covariance_px2,
+                                      double scale, int sides);
+
+struct RegionOptions {
+  double confidence = 0.95;
+  double max_polygon_error_px = 0.5;  // bound on polygon-to-ellipse distance...
+  int min_sides = 8;
+  int max_sides = 64;                 // ...unless this cap is hit (huge ellipses)
+};
+
+// ---- Expansion and contraction (regions.cpp) ----
+Polygon expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& options);
+// `hull` = the vertices of the convex hull of the means, counter-clockwise.
+Polygon contract_region(std::span<const ProjectedVertex> hull, const RegionOptions& options);
+
+// ---- One object (region_object.cpp) ----
+struct ObjectRegionOptions {
+  ProjectionOptions projection;
+  RegionOptions regions;
+  Assessment assessment = default_assessment();
+};
+
+struct ObjectRegions {
+  std::vector<ProjectedVertex> vertices;  // one per input vertex, same order
+  std::vector<int> hull;                  // indices of the mean hull, counter-clockwise
+  Polygon outer;                          // empty when !valid
+  Polygon inner;                          // empty when !valid or swamped by the error
+  double assessment = 0;                  // of the hull vertices; +inf when !valid
+  ProjectionFlags flags;                  // OR over all vertices
+  // Every vertex usable (in front of the camera under all sigma points, bounded pose):
+  // only then do the regions mean anything.
+  bool valid = false;
+};
+
+// The 3-D vertices are used as given (e.g. the object's 3-D hull, precomputed once per
+// object); no 3-D hull is computed here.
+ObjectRegions compute_object_regions(const Camera& camera, const UncertainPose& T_camera_object,
+                                     std::span<const Vec3> vertices_object,
+                                     const ObjectRegionOptions& options = {});
+
+}  // namespace covtrack::client

@@ -1,0 +1,125 @@
+#pragma once
+// A tree of frames whose edges are uncertain transforms T_parent_child: static ones, ones
+// tracked by a covtrack stream, and combined ones (several sources of the same transform,
+// one combiner). query(A, B, now) gives T_A_B with its BODY covariance.
+//
+// Propagation (DESIGN.md "Client math"): through the lowest common ancestor (LCA) of A and
+// B with exact first-order SE(3) Jacobians (graph_chain.hpp), so edges above the LCA,
+// shared by both paths, never enter. The seed's root-based models stay available for
+// comparison only (Propagation::SeedRoot, Propagation::SeedMatrix16).
+//
+// Edges are independent of each other. A tracked edge's covariance grows with the age of
+// its last report (graph_staleness.hpp); a LOST or never reported edge on the path makes
+// the result unbounded.
+//
+// Thread safety: every method may be called from any thread (one mutex). A query reads all
+// edges under one lock, so it never mixes two versions of the graph. Combiner callbacks run
+// under that lock: they must not call the graph.
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "covtrack/client/combiner.hpp"
+#include "covtrack/client/graph_staleness.hpp"
+#include "covtrack/client/tracked_transform.hpp"
+#include "covtrack/client/uncertain_pose.hpp"
+#include "covtrack/protocol/result.hpp"
+
+namespace covtrack::client {
+
+enum class Propagation {
+  LowestCommonAncestor,  // exact first-order Jacobians through the LCA (use this)
+  SeedRoot,              // exact Jacobians, but A and B each from the root, taken as
+                         // independent: the seed's section 4.9.1 flaw, isolated
+  SeedMatrix16,          // the seed's additive 16-element matrix model (appendix B, eq. 29),
+                         // from the root, converted to 6x6 BODY (graph_seed_matrix16.hpp)
+};
+
+struct StaticSource {
+  Pose T_parent_child = Pose::Identity();
+  Mat6 covariance = Mat6::Zero();  // BODY
+};
+
+struct TrackedSource {
+  StreamId stream;
+  MotionBound motion;  // how fast the child may move relative to the parent
+};
+
+using EdgeSource = std::variant<StaticSource, TrackedSource>;
+
+// Which source a combined edge on the path used, for the caller to see.
+struct EdgeChoice {
+  std::string child_frame;  // names the edge
+  std::size_t chosen = 0;   // index into the edge's sources
+  bool fused = false;
+};
+
+struct QueryResult {
+  UncertainPose pose;
+  std::vector<EdgeChoice> combiner_choices;  // one per combined edge on the path
+};
+
+class TransformGraph {
+ public:
+  explicit TransformGraph(Propagation mode = Propagation::LowestCommonAncestor);
+
+  // Each adds the edge parent -> child, creating frames as needed. Fails if `child`
+  // already has a parent or if the edge would close a cycle (or parent == child).
+  Result<void> add_static_edge(const std::string& parent, const std::string& child,
+                               const Pose& T_parent_child, const Mat6& covariance = Mat6::Zero());
+  Result<void> add_tracked_edge(const std::string& parent, const std::string& child,
+                                const StreamId& stream, const MotionBound& motion = {});
+  // Fails on an empty source list.
+  Result<void> add_combined_edge(const std::string& parent, const std::string& child,
+                                 std::vector<EdgeSource> sources, Combiner combiner);
+
+  // Stores the latest report of a stream (for every edge bound to it). A report measured
+  // before the stored one is ignored (out-of-order delivery). Fails if no edge is bound to
+  // the stream. Ready for Subscriber::on_pose: [&](auto& t) { (void)graph.update(t.stream, t); }
+  Result<void> update(const StreamId& stream, const TrackedTransform& report);
+  // The same for the tracked edge whose child frame is `edge_child_frame`; fails for an
+  // unknown frame, a static edge or a combined edge (update those by stream).
+  Result<void> update(const std::string& edge_child_frame, const TrackedTransform& report);
+
+  // T_A_B and its BODY covariance at time now_us (the graph's propagation mode, or the
+  // given one). Fails for an unknown frame or frames in different trees.
+  Result<UncertainPose> query(const std::string& A, const std::string& B, std::int64_t now_us) const;
+  Result<UncertainPose> query(const std::string& A, const std::string& B, std::int64_t now_us,
+                              Propagation mode) const;
+  Result<QueryResult> query_detailed(const std::string& A, const std::string& B,
+                                     std::int64_t now_us, Propagation mode) const;
+
+  bool has_frame(const std::string& frame) const;
+  void set_propagation(Propagation mode);
+
+ private:
+  struct Edge {
+    std::vector<EdgeSource> sources;
+    std::optional<Combiner> combiner;  // set when there are several sources
+  };
+  struct Frame {
+    std::optional<std::string> parent;
+    Edge edge;  // to the parent; empty for a root
+  };
+  struct EdgeValue {
+    UncertainPose value;
+    std::optional<EdgeChoice> choice;
+  };
+
+  Result<void> add_edge(const std::string& parent, const std::string& child, Edge edge);
+  Result<void> store_report(const StreamId& stream, const TrackedTransform& report);
+  std::vector<std::string> ancestry(const std::string& frame) const;  // frame, ..., root
+  UncertainPose source_value(const EdgeSource& source, std::int64_t now_us) const;
+  Result<EdgeValue> edge_value(const std::string& child, std::int64_t now_us) const;
+
+  mutable std::mutex mutex_;
+  Propagation mode_;
+  std::map<std::string, Frame> frames_;
+  std::map<std::string, TrackedTransform> latest_;  // by StreamId::key()
+};
+
+}  // namespace covtrack::client

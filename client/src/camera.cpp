@@ -1,0 +1,150 @@
+#include "covtrack/client/camera.hpp"
+
+#include <opencv2/core.hpp>
+
+#include <string>
+
+namespace covtrack::client {
+namespace {
+// GCC 12 has no <format>: a minimal "{}" substitution for error messages.
+std::string arg_string(const std::string& s) { return s; }
+std::string arg_string(const char* s) { return s; }
+std::string arg_string(int v) { return std::to_string(v); }
+
+template <typename... Args>
+std::string message(std::string pattern, const Args&... args) {
+  std::size_t from = 0;  // past the last insertion: a file name may itself contain "{}"
+  for (const std::string& a : {arg_string(args)...}) {
+    const auto at = pattern.find("{}", from);
+    if (at == std::string::npos) break;
+    pattern.replace(at, 2, a);
+    from = at + a.size();
+  }
+  return pattern;
+}
+}  // namespace
+
+Vec2 Camera::project(const Vec3& p, Mat23* J_pixel_point) const {
+  const double iz = 1.0 / p.z();
+  const double x = p.x() * iz, y = p.y() * iz;
+  const double r2 = x * x + y * y;
+  const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
+  const double yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
+  if (J_pixel_point) {
+    // Chain rule: pixel <- distorted (xd, yd) <- normalised (x, y) <- point.
+    const double dradial_dr2 = k1 + r2 * (2 * k2 + 3 * k3 * r2);
+    const double drad_dx = 2 * x * dradial_dr2, drad_dy = 2 * y * dradial_dr2;
+    Mat2 D;
+    D(0, 0) = radial + x * drad_dx + 2 * p1 * y + 6 * p2 * x;
+    D(0, 1) = x * drad_dy + 2 * p1 * x + 2 * p2 * y;
+    D(1, 0) = y * drad_dx + 2 * p1 * x + 2 * p2 * y;
+    D(1, 1) = radial + y * drad_dy + 6 * p1 * y + 2 * p2 * x;
+    Mat23 N;
+    N << iz, 0, -x * iz, 0, iz, -y * iz;
+    Mat2 F;
+    F << fx, 0, 0, fy;
+    *J_pixel_point = F * D * N;
+  }
+  return {fx * xd + cx, fy * yd + cy};
+}
+
+Mat2 Camera::intrinsic_covariance(const Vec3& p) const {
+  if (intrinsic_sigmas_px.isZero()) return Mat2::Zero();
+  // u = fx xd + cx, v = fy yd + cy: d(u,v)/d(fx,fy,cx,cy) = [xd 0 1 0; 0 yd 0 1].
+  const Vec2 centred = project(p) - Vec2(cx, cy);
+  Eigen::Matrix<double, 2, 4> J;
+  J << centred.x() / fx, 0, 1, 0, 0, centred.y() / fy, 0, 1;
+  const Eigen::Vector4d var = intrinsic_sigmas_px.cwiseAbs2();
+  return J * var.asDiagonal() * J.transpose();
+}
+
+namespace {
+
+Result<cv::Mat> read_matrix(const cv::FileStorage& fs, const std::string& file,
+                            const char* key, bool required) {
+  const cv::FileNode node = fs[key];
+  if (node.empty()) {
+    if (!required) return cv::Mat();
+    return fail(message("{}: missing key '{}'", file, key));
+  }
+  cv::Mat m;
+  try {
+    node >> m;
+  } catch (const cv::Exception& e) {
+    return fail(message("{}: key '{}' is not a matrix: {}", file, key, e.what()));
+  }
+  if (m.empty()) return fail(message("{}: key '{}' is not a matrix", file, key));
+  m.convertTo(m, CV_64F);
+  return m.reshape(1, static_cast<int>(m.total()));  // one column, row-major order
+}
+
+Result<int> read_positive_int(const cv::FileStorage& fs, const std::string& file,
+                              const char* key) {
+  const cv::FileNode node = fs[key];
+  if (node.empty()) return fail(message("{}: missing key '{}'", file, key));
+  if (!node.isInt()) return fail(message("{}: key '{}' is not an integer", file, key));
+  const int v = static_cast<int>(node);
+  if (v <= 0) return fail(message("{}: key '{}' must be positive, is {}", file, key, v));
+  return v;
+}
+
+}  // namespace
+
+Result<Camera> load_camera(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  if (!std::filesystem::exists(path)) return fail(message("{}: no such file", file));
+  cv::FileStorage fs;
+  try {
+    // OpenCV throws on a malformed file; turn that into an error value.
+    if (!fs.open(file, cv::FileStorage::READ))
+      return fail(message("{}: cannot open as an OpenCV calibration file", file));
+  } catch (const cv::Exception& e) {
+    return fail(message("{}: not a readable OpenCV calibration file: {}", file, e.what()));
+  }
+
+  Camera cam;
+  auto width = read_positive_int(fs, file, "image_width");
+  if (!width) return std::unexpected(width.error());
+  auto height = read_positive_int(fs, file, "image_height");
+  if (!height) return std::unexpected(height.error());
+  cam.width_px = *width;
+  cam.height_px = *height;
+
+  auto K = read_matrix(fs, file, "camera_matrix", true);
+  if (!K) return std::unexpected(K.error());
+  if (K->total() != 9) return fail(message("{}: key 'camera_matrix' must be 3x3", file));
+  const auto k = [&](int i) { return K->at<double>(i); };
+  cam.fx = k(0), cam.cx = k(2), cam.fy = k(4), cam.cy = k(5);
+  if (!(cam.fx > 0 && cam.fy > 0) || k(1) != 0 || k(3) != 0 || k(6) != 0 || k(7) != 0 ||
+      k(8) != 1)
+    return fail(message(
+        "{}: key 'camera_matrix' is not a pinhole matrix [fx 0 cx; 0 fy cy; 0 0 1]", file));
+
+  auto dist = read_matrix(fs, file, "distortion_coefficients", true);
+  if (!dist) return std::unexpected(dist.error());
+  const int n = static_cast<int>(dist->total());
+  if (n < 4)
+    return fail(message("{}: key 'distortion_coefficients' needs 4 or 5 values, has {}",
+                            file, n));
+  for (int i = 5; i < n; ++i)
+    if (dist->at<double>(i) != 0)
+      return fail(message(
+          "{}: key 'distortion_coefficients': only k1 k2 p1 p2 k3 are supported, "
+          "coefficient {} is non-zero",
+          file, i));
+  cam.k1 = dist->at<double>(0), cam.k2 = dist->at<double>(1);
+  cam.p1 = dist->at<double>(2), cam.p2 = dist->at<double>(3);
+  cam.k3 = n > 4 ? dist->at<double>(4) : 0.0;
+
+  auto sig = read_matrix(fs, file, "intrinsics_std_deviations", false);
+  if (!sig) return std::unexpected(sig.error());
+  if (!sig->empty()) {
+    if (sig->total() < 4)
+      return fail(message("{}: key 'intrinsics_std_deviations' needs fx fy cx cy", file));
+    for (int i = 0; i < 4; ++i) cam.intrinsic_sigmas_px[i] = sig->at<double>(i);
+  }
+  return cam;
+}
+
+}  // namespace covtrack::client

@@ -1,0 +1,128 @@
+#include <algorithm>
+#include <numeric>
+
+#include "covtrack/client/regions.hpp"
+
+namespace covtrack::client {
+namespace {
+double cross(const Vec2& o, const Vec2& a, const Vec2& b) {
+  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+}
+}  // namespace
+
+std::vector<int> convex_hull_indices(std::span<const Vec2> p) {
+  const int n = static_cast<int>(p.size());
+  std::vector<int> idx(n);
+  std::iota(idx.begin(), idx.end(), 0);
+  std::sort(idx.begin(), idx.end(), [&](int a, int b) {
+    return p[a].x() < p[b].x() || (p[a].x() == p[b].x() && p[a].y() < p[b].y());
+  });
+  if (n < 3) {
+    if (n == 2 && p[idx[0]] == p[idx[1]]) idx.pop_back();
+    return idx;
+  }
+  std::vector<int> h(2 * n);
+  int k = 0;
+  for (int i = 0; i < n; ++i) {  // lower chain
+    while (k >= 2 && cross(p[h[k - 2]], p[h[k - 1]], p[idx[i]]) <= 0) --k;
+    h[k++] = idx[i];
+  }
+  for (int i = n - 2, t = k + 1; i >= 0; --i) {  // upper chain
+    while (k >= t && cross(p[h[k - 2]], p[h[k - 1]], p[idx[i]]) <= 0) --k;
+    h[k++] = idx[i];
+  }
+  h.resize(std::max(k - 1, 1));
+  return h;
+}
+
+namespace {
+// Akl-Toussaint: the points extreme in 8 directions span a convex polygon; nothing
+// strictly inside it can be on the hull. For the outer region (hundreds of ellipse-polygon
+// corners, most of them inside) this removes most points before the sort.
+Polygon drop_points_inside_extremes(std::span<const Vec2> points) {
+  const Vec2 dirs[8] = {{1, 0}, {1, 1}, {0, 1}, {-1, 1}, {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
+  int best[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  for (int i = 1; i < static_cast<int>(points.size()); ++i)
+    for (int k = 0; k < 8; ++k)
+      if (dirs[k].dot(points[i]) > dirs[k].dot(points[best[k]])) best[k] = i;
+  Polygon octagon;  // counter-clockwise, repeated corners removed
+  for (int k = 0; k < 8; ++k)
+    if (octagon.empty() || points[best[k]] != octagon.back()) octagon.push_back(points[best[k]]);
+  while (octagon.size() > 1 && octagon.front() == octagon.back()) octagon.pop_back();
+  Polygon kept;
+  kept.reserve(points.size());
+  const std::size_t m = octagon.size();
+  for (const Vec2& q : points) {
+    bool strictly_inside = m >= 3;
+    for (std::size_t i = 0; i < m && strictly_inside; ++i)
+      strictly_inside = cross(octagon[i], octagon[(i + 1) % m], q) > 0;
+    if (!strictly_inside) kept.push_back(q);
+  }
+  return kept;
+}
+}  // namespace
+
+Polygon convex_hull(std::span<const Vec2> points) {
+  // The same monotone chain on the values: sorting points directly, not indices, is
+  // what keeps the outer region cheap.
+  Polygon p = points.size() > 32 ? drop_points_inside_extremes(points)
+                                 : Polygon(points.begin(), points.end());
+  std::sort(p.begin(), p.end(), [](const Vec2& a, const Vec2& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  const int n = static_cast<int>(p.size());
+  if (n < 3) {
+    if (n == 2 && p[0] == p[1]) p.pop_back();
+    return p;
+  }
+  Polygon h(2 * n);
+  int k = 0;
+  for (int i = 0; i < n; ++i) {
+    while (k >= 2 && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  for (int i = n - 2, t = k + 1; i >= 0; --i) {
+    while (k >= t && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  h.resize(std::max(k - 1, 1));
+  return h;
+}
+
+Polygon clip_half_plane(const Polygon& poly, const Vec2& normal, double offset) {
+  Polygon out;
+  const std::size_t n = poly.size();
+  out.reserve(n + 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2& a = poly[i];
+    const Vec2& b = poly[(i + 1) % n];
+    const double da = normal.dot(a) - offset, db = normal.dot(b) - offset;
+    if (da <= 0) out.push_back(a);
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) out.push_back(a + (da / (da - db)) * (b - a));
+  }
+  return out;
+}
+
+bool polygon_contains(const Polygon& poly, const Vec2& q, double tol) {
+  const std::size_t n = poly.size();
+  if (n < 3) return false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2& a = poly[i];
+    const Vec2 e = poly[(i + 1) % n] - a;
+    // Counter-clockwise: the interior is on the left of every edge.
+    if ((e.x() * (q.y() - a.y()) - e.y() * (q.x() - a.x())) / e.norm() < -tol) return false;
+  }
+  return true;
+}
+
+double polygon_area(const Polygon& poly) {
+  double twice = 0;
+  for (std::size_t i = 0, n = poly.size(); i < n; ++i) {
+    const Vec2& a = poly[i];
+    const Vec2& b = poly[(i + 1) % n];
+    twice += a.x() * b.y() - a.y() * b.x();
+  }
+  return 0.5 * twice;
+}
+
+}  // namespace covtrack::client

@@ -1,0 +1,127 @@
+// One frame = 1,000 objects x 8 hull vertices: projection + outer + inner + assessment.
+// Unscented (default) vs the linear fast path vs a 1,000-sample Monte Carlo of the same
+// frame. Single thread. Run: build/tests/client/bench_regions
+#include <random>
+
+#include <benchmark/benchmark.h>
+
+#include <Eigen/Cholesky>
+
+#include "covtrack/client/regions.hpp"
+
+using namespace covtrack;
+using namespace covtrack::client;
+
+namespace {
+
+struct Frame {
+  Camera camera;
+  std::vector<UncertainPose> poses;
+  std::vector<std::vector<Vec3>> vertices;
+};
+
+const Frame& frame() {
+  static const Frame f = [] {
+    Frame f;
+    f.camera.fx = 552.31, f.camera.fy = 551.08, f.camera.cx = 318.74, f.camera.cy = 243.52;
+    f.camera.width_px = 640, f.camera.height_px = 480;
+    f.camera.k1 = -0.04127, f.camera.k2 = 0.1834, f.camera.k3 = -0.2915;
+    f.camera.p1 = 6.1e-4, f.camera.p2 = -3.2e-4;
+    std::mt19937_64 rng(1);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (int i = 0; i < 1000; ++i) {
+      const Vec3 t(0.8 * u(rng), 0.6 * u(rng), 2.5 + u(rng));
+      const Vec3 axis = Vec3(u(rng), u(rng), u(rng)).normalized();
+      Vec6 d;
+      d << Vec3::Constant(std::pow(0.002 + 0.004 * (u(rng) + 1), 2)),
+          Vec3::Constant(std::pow((1 + 2 * (u(rng) + 1)) * 3.14159 / 180, 2));
+      f.poses.push_back({pose_from(t, Eigen::Quaterniond(Eigen::AngleAxisd(3 * u(rng), axis))),
+                         d.asDiagonal(), false});
+      std::vector<Vec3> box;
+      const double s = 0.1 + 0.05 * u(rng);
+      for (int k = 0; k < 8; ++k)
+        box.emplace_back(k & 1 ? s : -s, k & 2 ? 0.7 * s : -0.7 * s, k & 4 ? 0.5 * s : -0.5 * s);
+      f.vertices.push_back(box);
+    }
+    return f;
+  }();
+  return f;
+}
+
+void run_frame(benchmark::State& state, ProjectionMethod method) {
+  const Frame& f = frame();
+  ObjectRegionOptions o;
+  o.projection.method = method;
+  for (auto _ : state) {
+    for (std::size_t i = 0; i < f.poses.size(); ++i) {
+      ObjectRegions r = compute_object_regions(f.camera, f.poses[i], f.vertices[i], o);
+      benchmark::DoNotOptimize(r.assessment);
+    }
+  }
+  state.counters["objects"] = double(f.poses.size());
+}
+
+void BM_FrameUnscented(benchmark::State& state) { run_frame(state, ProjectionMethod::unscented); }
+void BM_FrameLinear(benchmark::State& state) { run_frame(state, ProjectionMethod::linear); }
+
+// The same regions from sample covariances of 1,000 sampled poses per object.
+void BM_FrameMonteCarlo1000(benchmark::State& state) {
+  const Frame& f = frame();
+  const RegionOptions ro;
+  const Assessment assessment = default_assessment();
+  std::mt19937_64 rng(2);
+  std::normal_distribution<double> normal;
+  constexpr int kSamples = 1000;
+  for (auto _ : state) {
+    for (std::size_t i = 0; i < f.poses.size(); ++i) {
+      const auto& verts = f.vertices[i];
+      const Mat6 L = Eigen::LLT<Mat6>(f.poses[i].covariance).matrixL();
+      std::vector<Vec2> sum(verts.size(), Vec2::Zero());
+      std::vector<Mat2> second(verts.size(), Mat2::Zero());
+      for (int s = 0; s < kSamples; ++s) {
+        Vec6 z;
+        for (int k = 0; k < 6; ++k) z[k] = normal(rng);
+        const Pose T = f.poses[i].T * se3_exp(L * z);
+        for (std::size_t v = 0; v < verts.size(); ++v) {
+          const Vec2 px = f.camera.project(T * verts[v]);
+          sum[v] += px;
+          second[v] += px * px.transpose();
+        }
+      }
+      std::vector<ProjectedVertex> pv(verts.size());
+      for (std::size_t v = 0; v < verts.size(); ++v) {
+        pv[v].mean_px = sum[v] / kSamples;
+        pv[v].covariance_px2 =
+            (second[v] - kSamples * pv[v].mean_px * pv[v].mean_px.transpose()) / (kSamples - 1);
+      }
+      std::vector<Vec2> means;
+      for (const auto& v : pv) means.push_back(v.mean_px);
+      std::vector<ProjectedVertex> hull;
+      for (int h : convex_hull_indices(means)) hull.push_back(pv[h]);
+      Polygon outer = expand_region(pv, ro);
+      Polygon inner = contract_region(hull, ro);
+      double a = assess(assessment, hull);
+      benchmark::DoNotOptimize(outer.data());
+      benchmark::DoNotOptimize(inner.data());
+      benchmark::DoNotOptimize(a);
+    }
+  }
+}
+
+// Where the time goes: projection alone (UT), no regions.
+void BM_FrameProjectionOnlyUnscented(benchmark::State& state) {
+  const Frame& f = frame();
+  for (auto _ : state)
+    for (std::size_t i = 0; i < f.poses.size(); ++i) {
+      auto v = project_vertices(f.camera, f.poses[i], f.vertices[i]);
+      benchmark::DoNotOptimize(v.data());
+    }
+}
+
+}  // namespace
+
+BENCHMARK(BM_FrameUnscented)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameLinear)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameProjectionOnlyUnscented)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameMonteCarlo1000)->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();

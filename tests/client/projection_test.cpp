@@ -1,0 +1,294 @@
+// Camera model, linear and unscented vertex projection, flags, calibration files.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+
+#include "covtrack/client/camera.hpp"
+#include "covtrack/client/projection.hpp"
+
+using namespace covtrack;
+using namespace covtrack::client;
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// Same numbers as config/cameras/example_640x480.yml, distortion included.
+Camera example_camera() {
+  Camera c;
+  c.fx = 552.31, c.fy = 551.08, c.cx = 318.74, c.cy = 243.52;
+  c.width_px = 640, c.height_px = 480;
+  c.k1 = -0.04127, c.k2 = 0.1834, c.p1 = 6.1e-4, c.p2 = -3.2e-4, c.k3 = -0.2915;
+  return c;
+}
+
+// An object about 2 m ahead, turned a little, seen off-centre.
+Pose object_pose() {
+  return pose_from(Vec3(0.15, -0.08, 1.8),
+                   Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Vec3(0.3, 1, 0.2).normalized())));
+}
+
+Mat6 covariance(double translation_sigma_m, double rotation_sigma_rad) {
+  Vec6 d;
+  d << Vec3::Constant(translation_sigma_m * translation_sigma_m),
+      Vec3::Constant(rotation_sigma_rad * rotation_sigma_rad);
+  Mat6 C = d.asDiagonal();
+  // Some correlation between translation and rotation, as a real tracker reports.
+  C(0, 4) = C(4, 0) = 0.3 * translation_sigma_m * rotation_sigma_rad;
+  return C;
+}
+
+double relative_frobenius(const Mat2& a, const Mat2& reference) {
+  return (a - reference).norm() / reference.norm();
+}
+
+// Monte Carlo reference: xi ~ N(0, C), pixel of T Exp(xi) p, sample covariance.
+Mat2 monte_carlo_covariance(const Camera& cam, const UncertainPose& pose, const Vec3& p,
+                            int samples) {
+  std::mt19937_64 rng(12345);
+  std::normal_distribution<double> normal;
+  const Mat6 L = Eigen::LLT<Mat6>(pose.covariance).matrixL();
+  Vec2 mean = Vec2::Zero();
+  Mat2 second = Mat2::Zero();
+  for (int i = 0; i < samples; ++i) {
+    Vec6 z;
+    for (int k = 0; k < 6; ++k) z[k] = normal(rng);
+    const Vec2 px = cam.project(pose.T * se3_exp(L * z) * p);
+    mean += px;
+    second += px * px.transpose();
+  }
+  mean /= samples;
+  return (second - samples * mean * mean.transpose()) / (samples - 1);
+}
+
+}  // namespace
+
+TEST(Camera, ProjectJacobianMatchesFiniteDifferences) {
+  const Camera cam = example_camera();
+  for (const Vec3& p : {Vec3(0.3, -0.2, 1.5), Vec3(-0.7, 0.5, 1.2), Vec3(0, 0, 3)}) {
+    Mat23 J;
+    cam.project(p, &J);
+    Mat23 Jfd;
+    const double h = 1e-6;
+    for (int k = 0; k < 3; ++k) {
+      Vec3 d = Vec3::Zero();
+      d[k] = h;
+      Jfd.col(k) = (cam.project(p + d) - cam.project(p - d)) / (2 * h);
+    }
+    EXPECT_LT((J - Jfd).norm(), 1e-5 * J.norm()) << "at " << p.transpose();
+  }
+}
+
+TEST(Camera, OpticalAxisHitsPrincipalPointAndYGoesDown) {
+  const Camera cam = example_camera();
+  const Vec2 centre = cam.project(Vec3(0, 0, 2));
+  EXPECT_NEAR(centre.x(), cam.cx, 1e-12);
+  EXPECT_NEAR(centre.y(), cam.cy, 1e-12);
+  EXPECT_GT(cam.project(Vec3(0, 0.1, 2)).y(), cam.cy);  // +y is down the image
+  EXPECT_GT(cam.project(Vec3(0.1, 0, 2)).x(), cam.cx);  // +x is right
+}
+
+TEST(Projection, LinearJacobianMatchesFiniteDifferences) {
+  const Camera cam = example_camera();
+  const Pose T = object_pose();
+  const Vec3 p(0.25, -0.15, 0.2);
+  const Mat26 J = pixel_jacobian_wrt_perturbation(cam, T, p);
+  Mat26 Jfd;
+  const double h = 1e-6;
+  for (int k = 0; k < 6; ++k) {
+    Vec6 d = Vec6::Zero();
+    d[k] = h;
+    Jfd.col(k) = (cam.project(T * se3_exp(d) * p) - cam.project(T * se3_exp(-d) * p)) / (2 * h);
+  }
+  EXPECT_LT((J - Jfd).norm(), 1e-6 * J.norm()) << "J\n" << J << "\nfd\n" << Jfd;
+}
+
+TEST(Projection, UnscentedMatchesMonteCarloAndBeatsLinearAtLargeRotation) {
+  const Camera cam = example_camera();
+  const Vec3 p(0.25, -0.15, 0.2);
+  ProjectionOptions ut, lin;
+  ut.add_intrinsic_uncertainty = lin.add_intrinsic_uncertainty = false;
+  lin.method = ProjectionMethod::linear;
+
+  struct Case {
+    double rot_deg, ut_goal, linear_floor;
+  };
+  for (const Case c : {Case{2, 0.01, 0.0}, Case{10, 0.03, 0.0}}) {
+    const UncertainPose pose{object_pose(), covariance(0.01, c.rot_deg * kDeg), false};
+    const Mat2 mc = monte_carlo_covariance(cam, pose, p, 400'000);
+    const ProjectedVertex vu = project_vertex(cam, pose, p, ut);
+    const ProjectedVertex vl = project_vertex(cam, pose, p, lin);
+    const double eu = relative_frobenius(vu.covariance_px2, mc);
+    const double el = relative_frobenius(vl.covariance_px2, mc);
+    std::printf("rotation sigma %4.1f deg: MC sigma_u %.2f px; relative Frobenius error "
+                "UT %.4f, linear %.4f\n",
+                c.rot_deg, std::sqrt(mc(0, 0)), eu, el);
+    EXPECT_FALSE(vu.flags.any());
+    EXPECT_LT(eu, c.ut_goal) << c.rot_deg << " deg";
+    if (c.rot_deg >= 10) {
+      EXPECT_GT(el, eu) << "the UT should beat the linearisation here";
+    }
+  }
+}
+
+TEST(Projection, UnscentedEqualsLinearWhenTheMapIsLinear) {
+  // Translation-only error on a distortion-free camera, far away: almost linear, so the
+  // two methods must agree closely (a check on the UT weights).
+  Camera cam = example_camera();
+  cam.k1 = cam.k2 = cam.k3 = cam.p1 = cam.p2 = 0;
+  Mat6 C = Mat6::Zero();
+  C.topLeftCorner<3, 3>() = 1e-6 * Mat3::Identity();
+  const UncertainPose pose{pose_from(Vec3(0, 0, 20), Eigen::Quaterniond::Identity()), C, false};
+  ProjectionOptions lin;
+  lin.method = ProjectionMethod::linear;
+  const ProjectedVertex u = project_vertex(cam, pose, Vec3(0.1, 0.1, 0));
+  const ProjectedVertex l = project_vertex(cam, pose, Vec3(0.1, 0.1, 0), lin);
+  EXPECT_LT(relative_frobenius(u.covariance_px2, l.covariance_px2), 1e-4);
+  EXPECT_LT((u.mean_px - l.mean_px).norm(), 1e-3);
+}
+
+TEST(Projection, ScaledUnscentedOptionIsUsed) {
+  const Camera cam = example_camera();
+  const UncertainPose pose{object_pose(), covariance(0.01, 10 * kDeg), false};
+  ProjectionOptions scaled;
+  scaled.unscented = {.alpha = 0.5, .beta = 2.0, .kappa = 0.0};
+  const ProjectedVertex a = project_vertex(cam, pose, Vec3(0.25, -0.15, 0.2));
+  const ProjectedVertex b = project_vertex(cam, pose, Vec3(0.25, -0.15, 0.2), scaled);
+  EXPECT_GT((a.covariance_px2 - b.covariance_px2).norm(), 1e-9);  // a different rule...
+  EXPECT_LT(relative_frobenius(b.covariance_px2, a.covariance_px2), 0.1);  // ...same answer
+}
+
+TEST(Projection, IntrinsicSigmasAddCovariance) {
+  Camera cam = example_camera();
+  const UncertainPose pose{object_pose(), covariance(0.001, 0.1 * kDeg), false};
+  const Vec3 p(0.25, -0.15, 0.2);
+  const ProjectedVertex without = project_vertex(cam, pose, p);
+  cam.intrinsic_sigmas_px << 2, 2, 1, 1;
+  const ProjectedVertex with = project_vertex(cam, pose, p);
+  const Mat2 added = with.covariance_px2 - without.covariance_px2;
+  // cx, cy alone add 1 px^2 on the diagonal; fx, fy add more off the principal point.
+  EXPECT_GT(added(0, 0), 1.0);
+  EXPECT_GT(added(1, 1), 1.0);
+  EXPECT_LT(added(0, 0), 1.0 + 4.0);
+}
+
+TEST(ProjectionFlags, BehindCamera) {
+  const Camera cam = example_camera();
+  const UncertainPose pose{pose_from(Vec3(0, 0, -1), Eigen::Quaterniond::Identity()),
+                           covariance(0.01, 1 * kDeg), false};
+  const ProjectedVertex v = project_vertex(cam, pose, Vec3::Zero());
+  EXPECT_TRUE(v.flags.behind_camera);
+  EXPECT_FALSE(v.flags.usable());
+}
+
+TEST(ProjectionFlags, SigmaPointBehindCamera) {
+  // 5 cm in front, 5 cm of depth uncertainty: some sigma points land behind the camera.
+  const Camera cam = example_camera();
+  const UncertainPose pose{pose_from(Vec3(0, 0, 0.05), Eigen::Quaterniond::Identity()),
+                           covariance(0.05, 1 * kDeg), false};
+  const ProjectedVertex v = project_vertex(cam, pose, Vec3::Zero());
+  EXPECT_FALSE(v.flags.behind_camera);
+  EXPECT_TRUE(v.flags.sigma_point_behind_camera);
+  EXPECT_FALSE(v.flags.usable());
+}
+
+TEST(ProjectionFlags, LargeRotationSigmaAndUnbounded) {
+  const Camera cam = example_camera();
+  UncertainPose pose{object_pose(), covariance(0.01, 20 * kDeg), false};
+  EXPECT_TRUE(project_vertex(cam, pose, Vec3(0.1, 0, 0)).flags.rotation_too_uncertain);
+  pose.covariance = covariance(0.01, 10 * kDeg);
+  EXPECT_FALSE(project_vertex(cam, pose, Vec3(0.1, 0, 0)).flags.rotation_too_uncertain);
+  ProjectionOptions strict;
+  strict.max_rotation_sigma_rad = 5 * kDeg;
+  EXPECT_TRUE(project_vertex(cam, pose, Vec3(0.1, 0, 0), strict).flags.rotation_too_uncertain);
+
+  pose.unbounded = true;
+  pose.covariance = Mat6::Constant(std::numeric_limits<double>::infinity());
+  const ProjectedVertex v = project_vertex(cam, pose, Vec3(0.1, 0, 0));
+  EXPECT_TRUE(v.flags.unbounded);
+  EXPECT_FALSE(v.flags.usable());
+  EXPECT_TRUE(v.mean_px.allFinite());  // the pixel of the last estimate is still given
+}
+
+TEST(ProjectionFlags, SingularCovarianceIsFine) {
+  // Rotation known exactly: Cholesky fails, the eigen square root takes over.
+  const Camera cam = example_camera();
+  Mat6 C = Mat6::Zero();
+  C.topLeftCorner<3, 3>() = 1e-4 * Mat3::Identity();
+  const ProjectedVertex v = project_vertex(cam, {object_pose(), C, false}, Vec3(0.1, 0, 0));
+  EXPECT_TRUE(v.flags.usable());
+  EXPECT_GT(v.covariance_px2.trace(), 0);
+}
+
+// ---- calibration files ----
+
+namespace {
+std::filesystem::path write_temp(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / name;
+  std::ofstream(path) << text;
+  return path;
+}
+const char* kMatrix =
+    "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+    "   data: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n";
+const char* kDist =
+    "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
+    "   data: [ 0.1, -0.2, 0., 0., 0.05 ]\n";
+}  // namespace
+
+TEST(CameraFile, LoadsTheShippedExample) {
+  const auto cam = load_camera(COVTRACK_SOURCE_DIR "/config/cameras/example_640x480.yml");
+  ASSERT_TRUE(cam) << cam.error().message;
+  const Camera ref = example_camera();
+  EXPECT_EQ(cam->width_px, 640);
+  EXPECT_EQ(cam->height_px, 480);
+  EXPECT_DOUBLE_EQ(cam->fx, ref.fx);
+  EXPECT_DOUBLE_EQ(cam->cy, ref.cy);
+  EXPECT_DOUBLE_EQ(cam->k3, ref.k3);
+  EXPECT_DOUBLE_EQ(cam->p1, ref.p1);
+  EXPECT_DOUBLE_EQ(cam->intrinsic_sigmas_px[0], 1.8);
+}
+
+TEST(CameraFile, MissingFileNamesTheFile) {
+  const auto cam = load_camera("/nonexistent/cam.yml");
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find("/nonexistent/cam.yml"), std::string::npos);
+}
+
+TEST(CameraFile, MissingKeyNamesFileAndKey) {
+  const auto path = write_temp("covtrack_cam_nokey.yml",
+                               std::string("%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n") + kDist);
+  const auto cam = load_camera(path);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find(path.string()), std::string::npos) << cam.error().message;
+  EXPECT_NE(cam.error().message.find("camera_matrix"), std::string::npos) << cam.error().message;
+}
+
+TEST(CameraFile, MissingImageSizeAndUnsupportedDistortion) {
+  auto path = write_temp("covtrack_cam_nosize.yml",
+                         std::string("%YAML:1.0\n---\nimage_width: 640\n") + kMatrix + kDist);
+  auto cam = load_camera(path);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find("image_height"), std::string::npos) << cam.error().message;
+
+  path = write_temp("covtrack_cam_rational.yml",
+                    std::string("%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n") + kMatrix +
+                        "distortion_coefficients: !!opencv-matrix\n   rows: 8\n   cols: 1\n"
+                        "   dt: d\n   data: [ 0.1, -0.2, 0., 0., 0.05, 0.3, 0., 0. ]\n");
+  cam = load_camera(path);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find("distortion_coefficients"), std::string::npos);
+}
+
+TEST(CameraFile, GarbageIsAnErrorNotACrash) {
+  const auto path = write_temp("covtrack_cam_garbage.yml", "%YAML:1.0\n---\n[[[ :: not yaml\n");
+  const auto cam = load_camera(path);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find(path.string()), std::string::npos);
+}

@@ -1,0 +1,241 @@
+// Ellipse polygons, hulls, expansion and contraction, assessment, honesty on Monte Carlo.
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+
+#include "covtrack/client/regions.hpp"
+
+using namespace covtrack;
+using namespace covtrack::client;
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+Camera test_camera() {
+  Camera c;
+  c.fx = 552.31, c.fy = 551.08, c.cx = 318.74, c.cy = 243.52;
+  c.width_px = 640, c.height_px = 480;
+  c.k1 = -0.04127, c.k2 = 0.1834, c.p1 = 6.1e-4, c.p2 = -3.2e-4, c.k3 = -0.2915;
+  return c;
+}
+
+std::vector<Vec3> box_vertices(double sx, double sy, double sz) {
+  std::vector<Vec3> v;
+  for (int i = 0; i < 8; ++i)
+    v.emplace_back((i & 1 ? 0.5 : -0.5) * sx, (i & 2 ? 0.5 : -0.5) * sy, (i & 4 ? 0.5 : -0.5) * sz);
+  return v;
+}
+
+UncertainPose box_pose(double translation_sigma_m, double rotation_sigma_rad) {
+  Vec6 d;
+  d << Vec3::Constant(std::pow(translation_sigma_m, 2)), Vec3::Constant(std::pow(rotation_sigma_rad, 2));
+  return {pose_from(Vec3(0.1, 0.05, 1.5),
+                    Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Vec3(1, 2, 0.5).normalized()))),
+          d.asDiagonal(), false};
+}
+
+Mat2 random_covariance(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  Mat2 B;
+  B << 5 * u(rng), 5 * u(rng), 5 * u(rng), 5 * u(rng);
+  return B * B.transpose() + 0.01 * Mat2::Identity();
+}
+
+}  // namespace
+
+TEST(EllipsePolygon, ContainsTheEllipseWithinTheDocumentedBound) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Mat2 C = random_covariance(rng);
+    const Vec2 c(100 + trial, 50 - trial);
+    const double scale = confidence_scale(0.95);
+    const int sides = 8 + trial % 20;
+    const Polygon poly = circumscribed_ellipse_polygon(c, C, scale, sides);
+    ASSERT_EQ(static_cast<int>(poly.size()), sides);
+    ASSERT_GT(polygon_area(poly), 0) << "counter-clockwise";
+    const Mat2 L = Eigen::LLT<Mat2>(C).matrixL();
+    std::vector<Vec2> boundary;
+    for (int k = 0; k < 4000; ++k) {
+      const double t = 2 * std::numbers::pi * k / 4000;
+      boundary.push_back(c + scale * L * Vec2(std::cos(t), std::sin(t)));
+      ASSERT_TRUE(polygon_contains(poly, boundary.back(), 1e-9)) << "trial " << trial;
+    }
+    const double a = scale * ellipse_axes(C).major_px;
+    const double bound = a * (1 / std::cos(std::numbers::pi / sides) - 1);
+    for (const Vec2& vertex : poly) {
+      double nearest = 1e300;
+      for (const Vec2& b : boundary) nearest = std::min(nearest, (vertex - b).norm());
+      EXPECT_LE(nearest, bound * 1.0001 + 1e-3) << "trial " << trial;
+    }
+  }
+}
+
+TEST(EllipsePolygon, SideCountMeetsTheToleranceAndNoMore) {
+  for (double a : {1.0, 10.0, 100.0, 1000.0}) {
+    const int n = circumscribed_polygon_sides(a, 0.5, 3, 100000);
+    EXPECT_LE(a * (1 / std::cos(std::numbers::pi / n) - 1), 0.5) << a;
+    if (n > 3) {
+      EXPECT_GT(a * (1 / std::cos(std::numbers::pi / (n - 1)) - 1), 0.5) << a;
+    }
+  }
+  EXPECT_EQ(circumscribed_polygon_sides(1e6, 0.5, 8, 64), 64);  // the cap
+  EXPECT_EQ(circumscribed_polygon_sides(0.0, 0.5, 8, 64), 8);
+}
+
+TEST(ConvexHull, MonotoneChainDropsInteriorAndCollinearPoints) {
+  const std::vector<Vec2> pts = {{0, 0}, {2, 0}, {1, 0}, {2, 2}, {0, 2}, {1, 1}, {0.5, 1.5}, {2, 1}};
+  const Polygon h = convex_hull(pts);
+  ASSERT_EQ(h.size(), 4u);
+  EXPECT_DOUBLE_EQ(polygon_area(h), 4.0);
+  for (const Vec2& p : pts) EXPECT_TRUE(polygon_contains(h, p, 1e-12));
+  EXPECT_FALSE(polygon_contains(h, Vec2(2.1, 1), 1e-12));
+}
+
+TEST(ConvexHull, PrefilteredHullEqualsPlainMonotoneChain) {
+  // convex_hull drops points inside an 8-direction extreme polygon first (> 32 points);
+  // convex_hull_indices does not. Both must give the same polygon.
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> g(0, 50);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<Vec2> pts;
+    for (int i = 0; i < 40 + 30 * trial; ++i) pts.emplace_back(g(rng), 0.3 * g(rng));
+    const Polygon fast = convex_hull(pts);
+    Polygon plain;
+    for (int i : convex_hull_indices(pts)) plain.push_back(pts[i]);
+    ASSERT_EQ(fast.size(), plain.size()) << "trial " << trial;
+    for (std::size_t i = 0; i < fast.size(); ++i) EXPECT_EQ(fast[i], plain[i]);
+    for (const Vec2& p : pts) EXPECT_TRUE(polygon_contains(fast, p, 1e-9));
+  }
+}
+
+TEST(Regions, WithoutErrorAllRegionsAreTheMeanHull) {
+  const Camera cam = test_camera();
+  const auto verts = box_vertices(0.2, 0.15, 0.1);
+  ObjectRegionOptions o;
+  o.projection.add_intrinsic_uncertainty = false;
+  const ObjectRegions r = compute_object_regions(cam, box_pose(0, 0), verts, o);
+  ASSERT_TRUE(r.valid);
+  std::vector<Vec2> means;
+  for (int i : r.hull) means.push_back(r.vertices[i].mean_px);
+  const double hull_area = polygon_area(means);
+  EXPECT_GT(hull_area, 100);
+  EXPECT_NEAR(polygon_area(r.inner), hull_area, 1e-6 * hull_area);
+  EXPECT_NEAR(polygon_area(r.outer), hull_area, 1e-6 * hull_area);
+  EXPECT_NEAR(r.assessment, 0, 1e-9);
+}
+
+TEST(Regions, NestingInnerInHullInOuter) {
+  const Camera cam = test_camera();
+  const ObjectRegions r =
+      compute_object_regions(cam, box_pose(0.003, 1 * kDeg), box_vertices(0.2, 0.15, 0.1));
+  ASSERT_TRUE(r.valid);
+  ASSERT_FALSE(r.inner.empty());
+  Polygon hull;
+  for (int i : r.hull) hull.push_back(r.vertices[i].mean_px);
+  for (const Vec2& p : r.inner) EXPECT_TRUE(polygon_contains(hull, p, 1e-9));
+  for (const Vec2& p : hull) EXPECT_TRUE(polygon_contains(r.outer, p, 1e-9));
+  EXPECT_LT(polygon_area(r.inner), polygon_area(hull));
+  EXPECT_GT(polygon_area(r.outer), polygon_area(hull));
+}
+
+// Sample true poses; each projected vertex must fall in the outer region (>= 95%), and the
+// inner region must lie inside the true object's projected hull (>= 95% of samples).
+void check_honesty(double translation_sigma_m, double rotation_sigma_rad) {
+  const Camera cam = test_camera();
+  const auto verts = box_vertices(0.2, 0.15, 0.1);
+  const UncertainPose pose = box_pose(translation_sigma_m, rotation_sigma_rad);
+  ObjectRegionOptions o;
+  o.projection.add_intrinsic_uncertainty = false;
+  const ObjectRegions r = compute_object_regions(cam, pose, verts, o);
+  ASSERT_TRUE(r.valid);
+  ASSERT_FALSE(r.inner.empty());
+
+  std::mt19937_64 rng(99);
+  std::normal_distribution<double> normal;
+  const Mat6 L = Eigen::LLT<Mat6>(pose.covariance).matrixL();
+  const int samples = 20000;
+  int vertices_in_outer = 0, inner_inside_truth = 0;
+  for (int s = 0; s < samples; ++s) {
+    Vec6 z;
+    for (int k = 0; k < 6; ++k) z[k] = normal(rng);
+    const Pose T = pose.T * se3_exp(L * z);
+    std::vector<Vec2> px;
+    for (const Vec3& v : verts) {
+      px.push_back(cam.project(T * v));
+      vertices_in_outer += polygon_contains(r.outer, px.back(), 0);
+    }
+    const Polygon truth = convex_hull(px);
+    bool inside = true;
+    for (const Vec2& p : r.inner) inside = inside && polygon_contains(truth, p, 0);
+    inner_inside_truth += inside;
+  }
+  const double outer_rate = double(vertices_in_outer) / (samples * verts.size());
+  const double inner_rate = double(inner_inside_truth) / samples;
+  std::printf("sigma %.0f mm, %.0f deg: vertices in outer %.4f, inner inside truth %.4f "
+              "(areas: inner %.0f, outer %.0f px^2)\n",
+              translation_sigma_m * 1e3, rotation_sigma_rad / kDeg, outer_rate, inner_rate,
+              polygon_area(r.inner), polygon_area(r.outer));
+  EXPECT_GE(outer_rate, 0.95);
+  EXPECT_GE(inner_rate, 0.95);
+}
+
+TEST(Regions, HonestOnMonteCarloSmallError) { check_honesty(0.005, 2 * kDeg); }
+TEST(Regions, HonestOnMonteCarloRotationDominated) { check_honesty(0.002, 5 * kDeg); }
+
+TEST(Regions, InnerEmptyWhenErrorSwampsTheObject) {
+  const Camera cam = test_camera();
+  const ObjectRegions r =
+      compute_object_regions(cam, box_pose(0.1, 1 * kDeg), box_vertices(0.2, 0.15, 0.1));
+  ASSERT_TRUE(r.valid);
+  EXPECT_TRUE(r.inner.empty());
+  EXPECT_GT(polygon_area(r.outer), 0);
+}
+
+TEST(Regions, DegenerateHullHasNoInner) {
+  const Camera cam = test_camera();
+  const std::vector<Vec3> segment = {Vec3(-0.1, 0, 0), Vec3(0.1, 0, 0)};
+  const ObjectRegions r = compute_object_regions(cam, box_pose(0.002, 0.5 * kDeg), segment);
+  ASSERT_TRUE(r.valid);
+  EXPECT_TRUE(r.inner.empty());
+  EXPECT_GT(polygon_area(r.outer), 0);  // two ellipses still span an area
+}
+
+TEST(Regions, InvalidWhenBehindCamera) {
+  const Camera cam = test_camera();
+  UncertainPose pose = box_pose(0.005, 1 * kDeg);
+  pose.T.translation().z() = -1;
+  const ObjectRegions r = compute_object_regions(cam, pose, box_vertices(0.2, 0.15, 0.1));
+  EXPECT_FALSE(r.valid);
+  EXPECT_TRUE(r.flags.behind_camera);
+  EXPECT_TRUE(r.outer.empty());
+  EXPECT_TRUE(r.inner.empty());
+  EXPECT_TRUE(std::isinf(r.assessment));
+}
+
+TEST(Assessment, MetricsAndAggregators) {
+  ProjectedVertex a, b;
+  a.mean_px = {0, 0};
+  a.covariance_px2 << 4, 0, 0, 1;  // semi-axes 2 and 1 px at 1 sigma
+  b.mean_px = {100, 0};
+  b.covariance_px2 << 9, 0, 0, 9;  // circle of radius 3 px
+  const std::vector<ProjectedVertex> vs = {a, b};
+  const double s = confidence_scale(0.95);
+  EXPECT_NEAR(s, 2.447746830680816, 1e-12);
+  EXPECT_NEAR(largest_semi_axis_px(0.95)(a), 2 * s, 1e-12);
+  EXPECT_NEAR(ellipse_area_px2(0.95)(b), std::numbers::pi * 9 * s * s, 1e-9);
+  EXPECT_NEAR(assess(default_assessment(), vs), 3 * s, 1e-12);
+  EXPECT_NEAR(assess({largest_semi_axis_px(0.95), mean_value()}, vs), 2.5 * s, 1e-12);
+  EXPECT_NEAR(assess({largest_semi_axis_px(0.95), nearest_vertex_to(Vec2(10, 5))}, vs), 2 * s, 1e-12);
+  // Pluggable: any callable.
+  const Assessment custom{[](const ProjectedVertex& v) { return v.covariance_px2.trace(); },
+                          [](auto, std::span<const double> x) { return x[0] + x[1]; }};
+  EXPECT_DOUBLE_EQ(assess(custom, vs), 23.0);
+  std::vector<ProjectedVertex> bad = vs;
+  bad[1].flags.sigma_point_behind_camera = true;
+  EXPECT_TRUE(std::isinf(assess(default_assessment(), bad)));
+}
