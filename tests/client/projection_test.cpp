@@ -9,6 +9,8 @@
 
 #include <Eigen/Cholesky>
 
+#include "example_camera.hpp"
+
 #include "covtrack/client/camera.hpp"
 #include "covtrack/client/projection.hpp"
 
@@ -18,15 +20,6 @@ using namespace covtrack::client;
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-// Same numbers as config/cameras/example_640x480.yml, distortion included.
-Camera example_camera() {
-  Camera c;
-  c.fx = 552.31, c.fy = 551.08, c.cx = 318.74, c.cy = 243.52;
-  c.width_px = 640, c.height_px = 480;
-  c.k1 = -0.04127, c.k2 = 0.1834, c.p1 = 6.1e-4, c.p2 = -3.2e-4, c.k3 = -0.2915;
-  return c;
-}
 
 // An object about 2 m ahead, turned a little, seen off-centre.
 Pose object_pose() {
@@ -70,7 +63,7 @@ Mat2 monte_carlo_covariance(const Camera& cam, const UncertainPose& pose, const 
 }  // namespace
 
 TEST(Camera, ProjectJacobianMatchesFiniteDifferences) {
-  const Camera cam = example_camera();
+  const Camera cam = test::example_camera();
   for (const Vec3& p : {Vec3(0.3, -0.2, 1.5), Vec3(-0.7, 0.5, 1.2), Vec3(0, 0, 3)}) {
     Mat23 J;
     cam.project(p, &J);
@@ -86,7 +79,7 @@ TEST(Camera, ProjectJacobianMatchesFiniteDifferences) {
 }
 
 TEST(Camera, OpticalAxisHitsPrincipalPointAndYGoesDown) {
-  const Camera cam = example_camera();
+  const Camera cam = test::example_camera();
   const Vec2 centre = cam.project(Vec3(0, 0, 2));
   EXPECT_NEAR(centre.x(), cam.cx, 1e-12);
   EXPECT_NEAR(centre.y(), cam.cy, 1e-12);
@@ -95,7 +88,7 @@ TEST(Camera, OpticalAxisHitsPrincipalPointAndYGoesDown) {
 }
 
 TEST(Projection, LinearJacobianMatchesFiniteDifferences) {
-  const Camera cam = example_camera();
+  const Camera cam = test::example_camera();
   const Pose T = object_pose();
   const Vec3 p(0.25, -0.15, 0.2);
   const Mat26 J = pixel_jacobian_wrt_perturbation(cam, T, p);
@@ -110,7 +103,7 @@ TEST(Projection, LinearJacobianMatchesFiniteDifferences) {
 }
 
 TEST(Projection, UnscentedMatchesMonteCarloAndBeatsLinearAtLargeRotation) {
-  const Camera cam = example_camera();
+  const Camera cam = test::example_camera();
   const Vec3 p(0.25, -0.15, 0.2);
   ProjectionOptions ut, lin;
   ut.add_intrinsic_uncertainty = lin.add_intrinsic_uncertainty = false;
@@ -140,7 +133,7 @@ TEST(Projection, UnscentedMatchesMonteCarloAndBeatsLinearAtLargeRotation) {
 TEST(Projection, UnscentedEqualsLinearWhenTheMapIsLinear) {
   // Translation-only error on a distortion-free camera, far away: almost linear, so the
   // two methods must agree closely (a check on the UT weights).
-  Camera cam = example_camera();
+  Camera cam = test::example_camera();
   cam.k1 = cam.k2 = cam.k3 = cam.p1 = cam.p2 = 0;
   Mat6 C = Mat6::Zero();
   C.topLeftCorner<3, 3>() = 1e-6 * Mat3::Identity();
@@ -154,7 +147,7 @@ TEST(Projection, UnscentedEqualsLinearWhenTheMapIsLinear) {
 }
 
 TEST(Projection, ScaledUnscentedOptionIsUsed) {
-  const Camera cam = example_camera();
+  const Camera cam = test::example_camera();
   const UncertainPose pose{object_pose(), covariance(0.01, 10 * kDeg), false};
   ProjectionOptions scaled;
   scaled.unscented = {.alpha = 0.5, .beta = 2.0, .kappa = 0.0};
@@ -165,7 +158,7 @@ TEST(Projection, ScaledUnscentedOptionIsUsed) {
 }
 
 TEST(Projection, IntrinsicSigmasAddCovariance) {
-  Camera cam = example_camera();
+  Camera cam = test::example_camera();
   const UncertainPose pose{object_pose(), covariance(0.001, 0.1 * kDeg), false};
   const Vec3 p(0.25, -0.15, 0.2);
   const ProjectedVertex without = project_vertex(cam, pose, p);
@@ -179,7 +172,7 @@ TEST(Projection, IntrinsicSigmasAddCovariance) {
 }
 
 TEST(ProjectionFlags, BehindCamera) {
-  const Camera cam = example_camera();
+  const Camera cam = test::example_camera();
   const UncertainPose pose{pose_from(Vec3(0, 0, -1), Eigen::Quaterniond::Identity()),
                            covariance(0.01, 1 * kDeg), false};
   const ProjectedVertex v = project_vertex(cam, pose, Vec3::Zero());
@@ -189,7 +182,7 @@ TEST(ProjectionFlags, BehindCamera) {
 
 TEST(ProjectionFlags, SigmaPointBehindCamera) {
   // 5 cm in front, 5 cm of depth uncertainty: some sigma points land behind the camera.
-  const Camera cam = example_camera();
+  const Camera cam = test::example_camera();
   const UncertainPose pose{pose_from(Vec3(0, 0, 0.05), Eigen::Quaterniond::Identity()),
                            covariance(0.05, 1 * kDeg), false};
   const ProjectedVertex v = project_vertex(cam, pose, Vec3::Zero());
@@ -199,7 +192,7 @@ TEST(ProjectionFlags, SigmaPointBehindCamera) {
 }
 
 TEST(ProjectionFlags, LargeRotationSigmaAndUnbounded) {
-  const Camera cam = example_camera();
+  const Camera cam = test::example_camera();
   UncertainPose pose{object_pose(), covariance(0.01, 20 * kDeg), false};
   EXPECT_TRUE(project_vertex(cam, pose, Vec3(0.1, 0, 0)).flags.rotation_too_uncertain);
   pose.covariance = covariance(0.01, 10 * kDeg);
@@ -218,7 +211,7 @@ TEST(ProjectionFlags, LargeRotationSigmaAndUnbounded) {
 
 TEST(ProjectionFlags, SingularCovarianceIsFine) {
   // Rotation known exactly: Cholesky fails, the eigen square root takes over.
-  const Camera cam = example_camera();
+  const Camera cam = test::example_camera();
   Mat6 C = Mat6::Zero();
   C.topLeftCorner<3, 3>() = 1e-4 * Mat3::Identity();
   const ProjectedVertex v = project_vertex(cam, {object_pose(), C, false}, Vec3(0.1, 0, 0));
@@ -245,7 +238,7 @@ const char* kDist =
 TEST(CameraFile, LoadsTheShippedExample) {
   const auto cam = load_camera(COVTRACK_SOURCE_DIR "/config/cameras/example_640x480.yml");
   ASSERT_TRUE(cam) << cam.error().message;
-  const Camera ref = example_camera();
+  const Camera ref = test::example_camera();
   EXPECT_EQ(cam->width_px, 640);
   EXPECT_EQ(cam->height_px, 480);
   EXPECT_DOUBLE_EQ(cam->fx, ref.fx);

@@ -7,6 +7,8 @@
 
 #include <Eigen/Cholesky>
 
+#include "example_camera.hpp"
+
 #include "covtrack/client/regions.hpp"
 
 using namespace covtrack;
@@ -15,14 +17,6 @@ using namespace covtrack::client;
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-Camera test_camera() {
-  Camera c;
-  c.fx = 552.31, c.fy = 551.08, c.cx = 318.74, c.cy = 243.52;
-  c.width_px = 640, c.height_px = 480;
-  c.k1 = -0.04127, c.k2 = 0.1834, c.p1 = 6.1e-4, c.p2 = -3.2e-4, c.k3 = -0.2915;
-  return c;
-}
 
 std::vector<Vec3> box_vertices(double sx, double sy, double sz) {
   std::vector<Vec3> v;
@@ -114,7 +108,7 @@ TEST(ConvexHull, PrefilteredHullEqualsPlainMonotoneChain) {
 }
 
 TEST(Regions, WithoutErrorAllRegionsAreTheMeanHull) {
-  const Camera cam = test_camera();
+  const Camera cam = test::example_camera();
   const auto verts = box_vertices(0.2, 0.15, 0.1);
   ObjectRegionOptions o;
   o.projection.add_intrinsic_uncertainty = false;
@@ -130,7 +124,7 @@ TEST(Regions, WithoutErrorAllRegionsAreTheMeanHull) {
 }
 
 TEST(Regions, NestingInnerInHullInOuter) {
-  const Camera cam = test_camera();
+  const Camera cam = test::example_camera();
   const ObjectRegions r =
       compute_object_regions(cam, box_pose(0.003, 1 * kDeg), box_vertices(0.2, 0.15, 0.1));
   ASSERT_TRUE(r.valid);
@@ -146,7 +140,7 @@ TEST(Regions, NestingInnerInHullInOuter) {
 // Sample true poses; each projected vertex must fall in the outer region (>= 95%), and the
 // inner region must lie inside the true object's projected hull (>= 95% of samples).
 void check_honesty(double translation_sigma_m, double rotation_sigma_rad) {
-  const Camera cam = test_camera();
+  const Camera cam = test::example_camera();
   const auto verts = box_vertices(0.2, 0.15, 0.1);
   const UncertainPose pose = box_pose(translation_sigma_m, rotation_sigma_rad);
   ObjectRegionOptions o;
@@ -188,7 +182,7 @@ TEST(Regions, HonestOnMonteCarloSmallError) { check_honesty(0.005, 2 * kDeg); }
 TEST(Regions, HonestOnMonteCarloRotationDominated) { check_honesty(0.002, 5 * kDeg); }
 
 TEST(Regions, InnerEmptyWhenErrorSwampsTheObject) {
-  const Camera cam = test_camera();
+  const Camera cam = test::example_camera();
   const ObjectRegions r =
       compute_object_regions(cam, box_pose(0.1, 1 * kDeg), box_vertices(0.2, 0.15, 0.1));
   ASSERT_TRUE(r.valid);
@@ -197,7 +191,7 @@ TEST(Regions, InnerEmptyWhenErrorSwampsTheObject) {
 }
 
 TEST(Regions, DegenerateHullHasNoInner) {
-  const Camera cam = test_camera();
+  const Camera cam = test::example_camera();
   const std::vector<Vec3> segment = {Vec3(-0.1, 0, 0), Vec3(0.1, 0, 0)};
   const ObjectRegions r = compute_object_regions(cam, box_pose(0.002, 0.5 * kDeg), segment);
   ASSERT_TRUE(r.valid);
@@ -206,7 +200,7 @@ TEST(Regions, DegenerateHullHasNoInner) {
 }
 
 TEST(Regions, InvalidWhenBehindCamera) {
-  const Camera cam = test_camera();
+  const Camera cam = test::example_camera();
   UncertainPose pose = box_pose(0.005, 1 * kDeg);
   pose.T.translation().z() = -1;
   const ObjectRegions r = compute_object_regions(cam, pose, box_vertices(0.2, 0.15, 0.1));
