@@ -1,8 +1,5 @@
 #include "config.hpp"
 
-#include <fstream>
-#include <sstream>
-
 #include <fmt/format.h>
 
 #include "covtrack/protocol/channels.hpp"
@@ -99,16 +96,10 @@ void read_devices(TableReader& top, DaemonConfig& out) {
 }  // namespace
 
 Result<DaemonConfig> parse_config(std::string_view text, const std::string& source_name) {
-  toml::table root;
-  try {
-    root = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    const auto& b = e.source().begin;
-    return fail(fmt::format("{}:{}:{}: TOML syntax error: {}", source_name, b.line, b.column,
-                            e.description()));
-  }
+  auto root = parse_toml(text, source_name);
+  if (!root) return std::unexpected(root.error());
   ConfigErrors errors;
-  TableReader top(root, "", top_spec(), source_name, errors);
+  TableReader top(*root, "", top_spec(), source_name, errors);
   DaemonConfig out;
   out.daemon = read_daemon(top);
   read_devices(top, out);
@@ -117,11 +108,9 @@ Result<DaemonConfig> parse_config(std::string_view text, const std::string& sour
 }
 
 Result<DaemonConfig> load_config(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(fmt::format("{}: cannot read the config file", path));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_config(text.str(), path);
+  auto text = read_config_text(path);
+  if (!text) return std::unexpected(text.error());
+  return parse_config(*text, path);
 }
 
 std::string config_schema_markdown() {

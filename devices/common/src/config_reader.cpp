@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -186,6 +187,12 @@ std::vector<double> TableReader::numbers(std::string_view key) {
   return out;
 }
 
+Vec3 TableReader::vec3(std::string_view key, const Vec3& fallback) {
+  if (!has(key)) return fallback;
+  const auto v = numbers(key);
+  return v.size() == 3 ? Vec3(v[0], v[1], v[2]) : fallback;
+}
+
 std::vector<std::string> TableReader::strings(std::string_view key) {
   const KeySpec* spec;
   const toml::node* node = typed(key, &spec);
@@ -224,6 +231,24 @@ std::vector<const toml::table*> TableReader::tables(std::string_view key) {
     out.push_back(item.as_table());
   }
   return out;
+}
+
+Result<std::string> read_config_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return fail(path + ": cannot read the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+Result<toml::table> parse_toml(std::string_view text, const std::string& source_name) {
+  try {
+    return toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    const auto& b = e.source().begin;
+    return fail(fmt::format("{}:{}:{}: TOML syntax error: {}", source_name, b.line, b.column,
+                            e.description()));
+  }
 }
 
 std::string schema_markdown(const std::vector<const TableSpec*>& tables) {

@@ -54,10 +54,6 @@ const TableSpec& sim_motion_spec() {
 }
 
 namespace {
-Vec3 vec3(const std::vector<double>& v, const Vec3& fallback) {
-  return v.size() == 3 ? Vec3(v[0], v[1], v[2]) : fallback;
-}
-
 MotionConfig read_motion(TableReader& device) {
   MotionConfig m;
   const toml::table* table = device.table("motion");
@@ -70,7 +66,7 @@ MotionConfig read_motion(TableReader& device) {
            : kind == "random_walk"  ? MotionKind::RandomWalk
            : kind == "waypoints"    ? MotionKind::Waypoints
                                     : MotionKind::Circle;
-  if (r.has("center_m")) m.center_m = vec3(r.numbers("center_m"), m.center_m);
+  m.center_m = r.vec3("center_m", m.center_m);
   m.radius_m = r.number("radius_m", m.radius_m);
   m.period_s = r.number("period_s", m.period_s);
   m.walk_sigma_m = r.number("walk_sigma_m", m.walk_sigma_m);

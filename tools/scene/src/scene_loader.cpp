@@ -1,7 +1,5 @@
 #include <filesystem>
-#include <fstream>
 #include <numbers>
-#include <sstream>
 
 #include <fmt/format.h>
 
@@ -69,11 +67,9 @@ const TableSpec& object_spec() {
   return s;
 }
 
-Vec3 vec3(const std::vector<double>& v) { return v.size() == 3 ? Vec3(v[0], v[1], v[2]) : Vec3::Zero(); }
-
 Pose read_pose(TableReader& r) {
   Pose T = Pose::Identity();
-  if (r.has("position_m")) T.translation() = vec3(r.numbers("position_m"));
+  T.translation() = r.vec3("position_m");
   if (r.has("orientation_wxyz") && r.has("rotation_rpy_deg")) {
     r.error("orientation_wxyz", "give orientation_wxyz or rotation_rpy_deg, not both");
   } else if (r.has("orientation_wxyz")) {
@@ -86,7 +82,7 @@ Pose read_pose(TableReader& r) {
         T.linear() = quat.toRotationMatrix();
     }
   } else if (r.has("rotation_rpy_deg")) {
-    const Vec3 rpy = vec3(r.numbers("rotation_rpy_deg")) * std::numbers::pi / 180;
+    const Vec3 rpy = r.vec3("rotation_rpy_deg") * std::numbers::pi / 180;
     T.linear() = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
                   Eigen::AngleAxisd(rpy.x(), Vec3::UnitX())).toRotationMatrix();
   }
@@ -128,7 +124,7 @@ SceneObject read_object(TableReader& r) {
   if (r.has("box_m") == r.has("vertices_m")) {
     r.error("box_m", "give exactly one of box_m or vertices_m");
   } else if (r.has("box_m")) {
-    o.vertices_m = box(vec3(r.numbers("box_m")), r.has("box_center_m") ? vec3(r.numbers("box_center_m")) : Vec3::Zero());
+    o.vertices_m = box(r.vec3("box_m"), r.vec3("box_center_m"));
   } else {
     const auto flat = r.numbers("vertices_m");
     if (flat.size() % 3 != 0 || flat.empty())
@@ -142,15 +138,10 @@ SceneObject read_object(TableReader& r) {
 }  // namespace
 
 Result<Scene> parse_scene(std::string_view text, const std::string& source, const std::string& base_dir) {
-  toml::table root;
-  try {
-    root = toml::parse(text, source);
-  } catch (const toml::parse_error& e) {
-    return fail(fmt::format("{}:{}:{}: TOML syntax error: {}", source, e.source().begin.line,
-                            e.source().begin.column, e.description()));
-  }
+  auto root = parse_toml(text, source);
+  if (!root) return std::unexpected(root.error());
   ConfigErrors errors;
-  TableReader top(root, "", top_spec(), source, errors);
+  TableReader top(*root, "", top_spec(), source, errors);
   Scene scene;
   if (const toml::table* cam = top.table("camera")) {
     TableReader r(*cam, "camera", camera_spec(), source, errors);
@@ -175,11 +166,9 @@ Result<Scene> parse_scene(std::string_view text, const std::string& source, cons
 }
 
 Result<Scene> load_scene(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(path + ": cannot read the scene file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scene(text.str(), path, std::filesystem::path(path).parent_path().string());
+  auto text = read_config_text(path);
+  if (!text) return std::unexpected(text.error());
+  return parse_scene(*text, path, std::filesystem::path(path).parent_path().string());
 }
 
 std::string scene_schema_markdown() {

@@ -11,6 +11,9 @@
 
 #include <toml++/toml.h>
 
+#include "covtrack/protocol/result.hpp"
+#include "covtrack/protocol/se3.hpp"
+
 namespace covtrack {
 
 enum class ValueType { Integer, Float, String, Boolean, FloatArray, StringArray, Table, TableArray };
@@ -62,6 +65,8 @@ class TableReader {
                      std::string fallback = {});
   bool boolean(std::string_view key, bool fallback = false);
   std::vector<double> numbers(std::string_view key);
+  // A 3-number key (its spec has array_size 3); the fallback when absent or invalid.
+  Vec3 vec3(std::string_view key, const Vec3& fallback = Vec3::Zero());
   std::vector<std::string> strings(std::string_view key);
   // A sub-table, or nullptr if absent (an error if required or of the wrong type).
   const toml::table* table(std::string_view key);
@@ -86,6 +91,11 @@ class TableReader {
   std::string file_;
   ConfigErrors& errors_;
 };
+
+// The whole text of a config file, or an error naming it.
+Result<std::string> read_config_text(const std::string& path);
+// Parsed TOML, or one error "source:line:column: TOML syntax error: ...".
+Result<toml::table> parse_toml(std::string_view text, const std::string& source_name);
 
 // Markdown for config/schema.md: one section per table, one row per key.
 std::string schema_markdown(const std::vector<const TableSpec*>& tables);
