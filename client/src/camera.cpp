@@ -1,28 +1,11 @@
 #include "covtrack/client/camera.hpp"
 
+#include <fmt/format.h>
 #include <opencv2/core.hpp>
 
 #include <string>
 
 namespace covtrack::client {
-namespace {
-// GCC 12 has no <format>: a minimal "{}" substitution for error messages.
-std::string arg_string(const std::string& s) { return s; }
-std::string arg_string(const char* s) { return s; }
-std::string arg_string(int v) { return std::to_string(v); }
-
-template <typename... Args>
-std::string message(std::string pattern, const Args&... args) {
-  std::size_t from = 0;  // past the last insertion: a file name may itself contain "{}"
-  for (const std::string& a : {arg_string(args)...}) {
-    const auto at = pattern.find("{}", from);
-    if (at == std::string::npos) break;
-    pattern.replace(at, 2, a);
-    from = at + a.size();
-  }
-  return pattern;
-}
-}  // namespace
 
 Vec2 Camera::project(const Vec3& p, Mat23* J_pixel_point) const {
   const double iz = 1.0 / p.z();
@@ -66,15 +49,15 @@ Result<cv::Mat> read_matrix(const cv::FileStorage& fs, const std::string& file,
   const cv::FileNode node = fs[key];
   if (node.empty()) {
     if (!required) return cv::Mat();
-    return fail(message("{}: missing key '{}'", file, key));
+    return fail(fmt::format("{}: missing key '{}'", file, key));
   }
   cv::Mat m;
   try {
     node >> m;
   } catch (const cv::Exception& e) {
-    return fail(message("{}: key '{}' is not a matrix: {}", file, key, e.what()));
+    return fail(fmt::format("{}: key '{}' is not a matrix: {}", file, key, e.what()));
   }
-  if (m.empty()) return fail(message("{}: key '{}' is not a matrix", file, key));
+  if (m.empty()) return fail(fmt::format("{}: key '{}' is not a matrix", file, key));
   m.convertTo(m, CV_64F);
   return m.reshape(1, static_cast<int>(m.total()));  // one column, row-major order
 }
@@ -82,10 +65,10 @@ Result<cv::Mat> read_matrix(const cv::FileStorage& fs, const std::string& file,
 Result<int> read_positive_int(const cv::FileStorage& fs, const std::string& file,
                               const char* key) {
   const cv::FileNode node = fs[key];
-  if (node.empty()) return fail(message("{}: missing key '{}'", file, key));
-  if (!node.isInt()) return fail(message("{}: key '{}' is not an integer", file, key));
+  if (node.empty()) return fail(fmt::format("{}: missing key '{}'", file, key));
+  if (!node.isInt()) return fail(fmt::format("{}: key '{}' is not an integer", file, key));
   const int v = static_cast<int>(node);
-  if (v <= 0) return fail(message("{}: key '{}' must be positive, is {}", file, key, v));
+  if (v <= 0) return fail(fmt::format("{}: key '{}' must be positive, is {}", file, key, v));
   return v;
 }
 
@@ -93,14 +76,14 @@ Result<int> read_positive_int(const cv::FileStorage& fs, const std::string& file
 
 Result<Camera> load_camera(const std::filesystem::path& path) {
   const std::string file = path.string();
-  if (!std::filesystem::exists(path)) return fail(message("{}: no such file", file));
+  if (!std::filesystem::exists(path)) return fail(fmt::format("{}: no such file", file));
   cv::FileStorage fs;
   try {
     // OpenCV throws on a malformed file; turn that into an error value.
     if (!fs.open(file, cv::FileStorage::READ))
-      return fail(message("{}: cannot open as an OpenCV calibration file", file));
+      return fail(fmt::format("{}: cannot open as an OpenCV calibration file", file));
   } catch (const cv::Exception& e) {
-    return fail(message("{}: not a readable OpenCV calibration file: {}", file, e.what()));
+    return fail(fmt::format("{}: not a readable OpenCV calibration file: {}", file, e.what()));
   }
 
   Camera cam;
@@ -113,23 +96,23 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
 
   auto K = read_matrix(fs, file, "camera_matrix", true);
   if (!K) return std::unexpected(K.error());
-  if (K->total() != 9) return fail(message("{}: key 'camera_matrix' must be 3x3", file));
+  if (K->total() != 9) return fail(fmt::format("{}: key 'camera_matrix' must be 3x3", file));
   const auto k = [&](int i) { return K->at<double>(i); };
   cam.fx = k(0), cam.cx = k(2), cam.fy = k(4), cam.cy = k(5);
   if (!(cam.fx > 0 && cam.fy > 0) || k(1) != 0 || k(3) != 0 || k(6) != 0 || k(7) != 0 ||
       k(8) != 1)
-    return fail(message(
+    return fail(fmt::format(
         "{}: key 'camera_matrix' is not a pinhole matrix [fx 0 cx; 0 fy cy; 0 0 1]", file));
 
   auto dist = read_matrix(fs, file, "distortion_coefficients", true);
   if (!dist) return std::unexpected(dist.error());
   const int n = static_cast<int>(dist->total());
   if (n < 4)
-    return fail(message("{}: key 'distortion_coefficients' needs 4 or 5 values, has {}",
+    return fail(fmt::format("{}: key 'distortion_coefficients' needs 4 or 5 values, has {}",
                             file, n));
   for (int i = 5; i < n; ++i)
     if (dist->at<double>(i) != 0)
-      return fail(message(
+      return fail(fmt::format(
           "{}: key 'distortion_coefficients': only k1 k2 p1 p2 k3 are supported, "
           "coefficient {} is non-zero",
           file, i));
@@ -141,7 +124,7 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
   if (!sig) return std::unexpected(sig.error());
   if (!sig->empty()) {
     if (sig->total() < 4)
-      return fail(message("{}: key 'intrinsics_std_deviations' needs fx fy cx cy", file));
+      return fail(fmt::format("{}: key 'intrinsics_std_deviations' needs fx fy cx cy", file));
     for (int i = 0; i < 4; ++i) cam.intrinsic_sigmas_px[i] = sig->at<double>(i);
   }
   return cam;
