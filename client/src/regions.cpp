@@ -8,12 +8,12 @@ namespace covtrack::client {
 Polygon expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& o) {
   const double scale = confidence_scale(o.confidence);
   std::vector<Vec2> points;
-  points.reserve(vertices.size() * o.min_sides);
+  points.reserve(vertices.size() * o.max_sides);
   for (const ProjectedVertex& v : vertices) {
-    const double a = scale * ellipse_axes(v.covariance_px2).major_px;
-    const int n = circumscribed_polygon_sides(a, o.max_polygon_error_px, o.min_sides, o.max_sides);
-    const Polygon ellipse = circumscribed_ellipse_polygon(v.mean_px, v.covariance_px2, scale, n);
-    points.insert(points.end(), ellipse.begin(), ellipse.end());
+    const EllipseAxes axes = ellipse_axes(v.covariance_px2);
+    const int n = circumscribed_polygon_sides(scale * axes.major_px, o.max_polygon_error_px,
+                                              o.min_sides, o.max_sides);
+    append_circumscribed_ellipse_polygon(v.mean_px, axes, scale, n, points);
   }
   return convex_hull(points);
 }

@@ -44,6 +44,9 @@ int circumscribed_polygon_sides(double semi_major_px, double max_error_px, int m
 // The ellipse {x : (x-c)^T C^-1 (x-c) <= scale^2} circumscribed by an N-gon.
 Polygon circumscribed_ellipse_polygon(const Vec2& center_px, const Mat2& covariance_px2,
                                       double scale, int sides);
+// The same corners appended to `out`, for axes already known (no allocation of its own).
+void append_circumscribed_ellipse_polygon(const Vec2& center_px, const EllipseAxes& axes,
+                                          double scale, int sides, Polygon& out);
 
 struct RegionOptions {
   double confidence = 0.95;

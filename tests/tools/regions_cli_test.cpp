@@ -1,0 +1,136 @@
+// `covtrack regions` as a user runs it, on the shipped seed figure 10 scene: the JSON is
+// complete and self-consistent, the head-attached panel's error does not come from the
+// head tracker (unlike the seed's model), the picture is written, mistakes are reported.
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+struct CliRun {
+  int exit_code;
+  std::string out;  // stdout and stderr together
+};
+
+CliRun run(const std::string& args) {
+  const std::string cmd = std::string(COVTRACK_CLI) + " regions " + args + " 2>&1";
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (!pipe) return {-1, "popen failed"};
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+const std::string kScene = COVTRACK_SOURCE_DIR "/config/scenes/head_and_world.toml";
+
+nlohmann::json run_json(const std::string& extra = "") {
+  const CliRun r = run(kScene + " --json " + extra);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  return nlohmann::json::parse(r.out, nullptr, false);
+}
+
+const nlohmann::json& object(const nlohmann::json& doc, const std::string& name) {
+  for (const auto& o : doc["objects"])
+    if (o["name"] == name) return o;
+  static const nlohmann::json none;
+  ADD_FAILURE() << "no object " << name;
+  return none;
+}
+
+// Inside a counter-clockwise convex polygon (in u, v arithmetic), with a tolerance.
+bool inside(const nlohmann::json& polygon, double u, double v, double tolerance = 1e-6) {
+  const std::size_t n = polygon.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double au = polygon[i][0], av = polygon[i][1];
+    const double bu = polygon[(i + 1) % n][0], bv = polygon[(i + 1) % n][1];
+    const double cross = (bu - au) * (v - av) - (bv - av) * (u - au);
+    if (cross < -tolerance * std::hypot(bu - au, bv - av)) return false;
+  }
+  return n >= 3;
+}
+
+}  // namespace
+
+TEST(RegionsCli, JsonDescribesEveryHullVertexAndConsistentRegions) {
+  const nlohmann::json doc = run_json();
+  ASSERT_FALSE(doc.is_discarded());
+  ASSERT_EQ(doc["objects"].size(), 2u);
+  for (const auto& o : doc["objects"]) {
+    SCOPED_TRACE(o["name"].get<std::string>());
+    EXPECT_TRUE(o["valid"].get<bool>());
+    EXPECT_EQ(o["vertices"].size(), 8u) << "a box has 8 hull vertices";
+    EXPECT_GT(o["assessment_px"].get<double>(), 0.0);
+    for (const auto& v : o["vertices"]) {
+      const auto& c = v["covariance_px2"];
+      const double a = c[0][0], b = c[0][1], b2 = c[1][0], d = c[1][1];
+      EXPECT_DOUBLE_EQ(b, b2);
+      EXPECT_GT(a, 0);
+      EXPECT_GE(a * d - b * b, 0);
+      EXPECT_TRUE(inside(o["outer_px"], v["mean_px"][0], v["mean_px"][1]));
+    }
+    for (const auto& p : o["inner_px"]) EXPECT_TRUE(inside(o["outer_px"], p[0], p[1], 1e-3));
+  }
+}
+
+TEST(RegionsCli, HeadAttachedPanelErrorIsNotTheHeadTrackersAsInTheSeed) {
+  const nlohmann::json exact = run_json();
+  const nlohmann::json seed = run_json("--propagation seed-matrix16");
+  const double exact_panel = object(exact, "hud_panel")["assessment_px"];
+  const double seed_panel = object(seed, "hud_panel")["assessment_px"];
+  const double exact_table = object(exact, "table")["assessment_px"];
+  std::printf("hud_panel error: exact %.2f px, seed model %.2f px (%.1fx); table %.2f px\n",
+              exact_panel, seed_panel, seed_panel / exact_panel, exact_table);
+  // The seed's section 4.9.1 measured 5-78x too large on such a chain.
+  EXPECT_GT(seed_panel, 5 * exact_panel);
+  // The world object sees the 2-degree head tracker: far more error than the panel.
+  EXPECT_GT(exact_table, 5 * exact_panel);
+}
+
+TEST(RegionsCli, TextAndPngOutputs) {
+  const std::filesystem::path png = std::filesystem::temp_directory_path() / "covtrack_regions_test.png";
+  std::filesystem::remove(png);
+  const CliRun r = run(kScene + " --png " + png.string());
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("object hud_panel"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("outer ("), std::string::npos) << r.out;
+  std::ifstream in(png, std::ios::binary);
+  std::array<unsigned char, 8> magic{};
+  in.read(reinterpret_cast<char*>(magic.data()), magic.size());
+  EXPECT_EQ(magic, (std::array<unsigned char, 8>{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'}));
+  EXPECT_GT(std::filesystem::file_size(png), 1000u);
+  std::filesystem::remove(png);
+}
+
+TEST(RegionsCli, MistakesAreReportedWithWhere) {
+  const std::filesystem::path bad = std::filesystem::temp_directory_path() / "covtrack_bad_scene.toml";
+  std::ofstream(bad) << "[camera]\nframe = \"camera\"\ncalibration = \"nope.yml\"\n\n[[object]]\nname = 3\n";
+  const CliRun r = run(bad.string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find(bad.string() + ":6"), std::string::npos) << r.out;
+  std::filesystem::remove(bad);
+
+  const CliRun missing = run("/nonexistent/scene.toml");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.out.find("/nonexistent/scene.toml"), std::string::npos) << missing.out;
+
+  const CliRun unwritable = run(kScene + " --png /nonexistent/dir/out.png");
+  EXPECT_NE(unwritable.exit_code, 0);
+  EXPECT_NE(unwritable.out.find("/nonexistent/dir/out.png"), std::string::npos) << unwritable.out;
+}
+
+TEST(RegionsCli, PrintSchemaIsTheShippedReference) {
+  const CliRun r = run("--print-schema");
+  ASSERT_EQ(r.exit_code, 0);
+  std::ifstream in(COVTRACK_SOURCE_DIR "/config/scene_schema.md");
+  const std::string shipped((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(r.out, shipped);
+}
