@@ -118,10 +118,49 @@ void BM_FrameProjectionOnlyUnscented(benchmark::State& state) {
     }
 }
 
+// Where the time goes: each region step alone, on the frame's projected vertices.
+const std::vector<std::vector<ProjectedVertex>>& projected_frame() {
+  static const auto projected = [] {
+    std::vector<std::vector<ProjectedVertex>> out;
+    const Frame& f = frame();
+    for (std::size_t i = 0; i < f.poses.size(); ++i)
+      out.push_back(project_vertices(f.camera, f.poses[i], f.vertices[i]));
+    return out;
+  }();
+  return projected;
+}
+
+void BM_FrameOuterOnly(benchmark::State& state) {
+  const RegionOptions ro;
+  for (auto _ : state)
+    for (const auto& vertices : projected_frame()) {
+      Polygon outer = expand_region(vertices, ro);
+      benchmark::DoNotOptimize(outer.data());
+    }
+}
+
+void BM_FrameInnerOnly(benchmark::State& state) {
+  const RegionOptions ro;
+  std::vector<std::vector<ProjectedVertex>> hulls;
+  for (const auto& vertices : projected_frame()) {
+    std::vector<Vec2> means;
+    for (const auto& v : vertices) means.push_back(v.mean_px);
+    hulls.emplace_back();
+    for (int h : convex_hull_indices(means)) hulls.back().push_back(vertices[h]);
+  }
+  for (auto _ : state)
+    for (const auto& hull : hulls) {
+      Polygon inner = contract_region(hull, ro);
+      benchmark::DoNotOptimize(inner.data());
+    }
+}
+
 }  // namespace
 
 BENCHMARK(BM_FrameUnscented)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameLinear)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameProjectionOnlyUnscented)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameOuterOnly)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameInnerOnly)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameMonteCarlo1000)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -134,3 +134,21 @@ TEST(RegionsCli, PrintSchemaIsTheShippedReference) {
   const std::string shipped((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_EQ(r.out, shipped);
 }
+
+TEST(RegionsCli, EveryShippedSceneGivesARegionForEveryObject) {
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(COVTRACK_SOURCE_DIR "/config/scenes")) {
+    if (entry.path().extension() != ".toml") continue;
+    ++scenes;
+    const CliRun r = run(entry.path().string() + " --json");
+    ASSERT_EQ(r.exit_code, 0) << entry.path() << "\n" << r.out;
+    const nlohmann::json doc = nlohmann::json::parse(r.out, nullptr, false);
+    ASSERT_FALSE(doc.is_discarded()) << entry.path();
+    EXPECT_FALSE(doc["objects"].empty()) << entry.path();
+    for (const auto& o : doc["objects"]) {
+      EXPECT_TRUE(o["valid"].get<bool>()) << entry.path() << ": " << o["name"];
+      EXPECT_TRUE(o["flags"].empty()) << entry.path() << ": " << o["name"];
+    }
+  }
+  EXPECT_GE(scenes, 2);
+}
