@@ -5,19 +5,6 @@
 
 namespace covtrack::client {
 
-Polygon expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& o) {
-  const double scale = confidence_scale(o.confidence);
-  std::vector<Vec2> points;
-  points.reserve(vertices.size() * o.max_sides);
-  for (const ProjectedVertex& v : vertices) {
-    const EllipseAxes axes = ellipse_axes(v.covariance_px2);
-    const int n = circumscribed_polygon_sides(scale * axes.major_px, o.max_polygon_error_px,
-                                              o.min_sides, o.max_sides);
-    append_circumscribed_ellipse_polygon(v.mean_px, axes, scale, n, points);
-  }
-  return convex_hull(points);
-}
-
 namespace {
 
 // min over the ellipse of n . x: the ellipse lies in {x : n . x >= inner_support}.

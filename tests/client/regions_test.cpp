@@ -1,4 +1,5 @@
 // Ellipse polygons, hulls, expansion and contraction, assessment, honesty on Monte Carlo.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -6,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "example_camera.hpp"
 
@@ -105,6 +107,52 @@ TEST(ConvexHull, PrefilteredHullEqualsPlainMonotoneChain) {
     for (std::size_t i = 0; i < fast.size(); ++i) EXPECT_EQ(fast[i], plain[i]);
     for (const Vec2& p : pts) EXPECT_TRUE(polygon_contains(fast, p, 1e-9));
   }
+}
+
+double distance_to_polygon_boundary(const Polygon& poly, const Vec2& q) {
+  double best = 1e300;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Vec2 a = poly[i], ab = poly[(i + 1) % poly.size()] - a;
+    const double t = std::clamp((q - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (q - (a + t * ab)).norm());
+  }
+  return best;
+}
+
+TEST(OuterRegion, ContainsEveryEllipseAndStaysWithinTheBound) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  const RegionOptions o;
+  const double scale = confidence_scale(o.confidence);
+  std::size_t corners = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<ProjectedVertex> vertices(2 + trial % 9);
+    for (ProjectedVertex& v : vertices) {
+      v.mean_px = Vec2(400 * u(rng), 300 * u(rng));
+      const double size = std::pow(10.0, 3 * u(rng) - 1.5);  // 0.03 to 30: tiny to huge
+      v.covariance_px2 = (u(rng) < 0.1 ? 0.0 : size * size) * random_covariance(rng) / 25;
+    }
+    const Polygon outer = expand_region(vertices, o);
+    ASSERT_GE(outer.size(), 3u);
+    ASSERT_GT(polygon_area(outer), 0) << "counter-clockwise";
+    corners += outer.size();
+    // Dense inscribed points of every ellipse: all inside the outer region, and their hull
+    // (inside the true hull of the ellipses) within the bound of every outer corner.
+    std::vector<Vec2> dense;
+    for (const ProjectedVertex& v : vertices) {
+      const Eigen::SelfAdjointEigenSolver<Mat2> eig(v.covariance_px2);
+      const Mat2 A = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+      for (int k = 0; k < 2000; ++k) {
+        const double t = 2 * std::numbers::pi * k / 2000;
+        dense.push_back(v.mean_px + scale * A * Vec2(std::cos(t), std::sin(t)));
+        ASSERT_TRUE(polygon_contains(outer, dense.back(), 1e-7)) << "trial " << trial;
+      }
+    }
+    const Polygon truth = convex_hull(dense);
+    for (const Vec2& q : outer)
+      EXPECT_LE(distance_to_polygon_boundary(truth, q), o.max_polygon_error_px + 0.01) << "trial " << trial;
+  }
+  std::printf("outer region: %.1f corners on average\n", double(corners) / 200);
 }
 
 TEST(Regions, WithoutErrorAllRegionsAreTheMeanHull) {

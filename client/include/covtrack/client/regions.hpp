@@ -7,8 +7,14 @@
 //    for a point A u on the ellipse, so the polygon lies within
 //        a (1/cos(pi/N) - 1)          (a = semi-major axis)
 //    of the ellipse; N is the smallest count meeting RegionOptions::max_polygon_error_px.
-//  - Outer region (expansion, 5.5.1): convex hull of all ellipse polygons. It contains
-//    every ellipse, so each vertex lies in it with probability >= p.
+//  - Outer region (expansion, 5.5.1): the seed's convex hull of the ellipses, as the
+//    intersection of its support half-planes {n . x <= h(n)}, h(n) = max over the ellipses
+//    of n . c + sqrt(n^T S n). It contains every ellipse, so each vertex lies in it with
+//    probability >= p. Directions start 45 degrees apart; a gap is split while the corner
+//    of its two lines is farther than max_polygon_error_px from the chord between their
+//    contact points (a chord lies inside the hull), so every corner, hence every point of
+//    the polygon, is within that distance of the hull. This costs a few dozen support
+//    evaluations per object instead of a hull over every ellipse's polygon (region_outer.cpp).
 //  - Inner region (contraction, 5.5.2): for each edge of the hull of the mean vertices, the
 //    line tangent to both adjacent ellipses on the interior side; the region is the
 //    intersection of the interior half-planes. Where the seed's construction (corners =
@@ -44,15 +50,13 @@ int circumscribed_polygon_sides(double semi_major_px, double max_error_px, int m
 // The ellipse {x : (x-c)^T C^-1 (x-c) <= scale^2} circumscribed by an N-gon.
 Polygon circumscribed_ellipse_polygon(const Vec2& center_px, const Mat2& covariance_px2,
                                       double scale, int sides);
-// The same corners appended to `out`, for axes already known (no allocation of its own).
-void append_circumscribed_ellipse_polygon(const Vec2& center_px, const EllipseAxes& axes,
-                                          double scale, int sides, Polygon& out);
 
 struct RegionOptions {
   double confidence = 0.95;
-  double max_polygon_error_px = 0.5;  // bound on polygon-to-ellipse distance...
-  int min_sides = 8;
-  int max_sides = 64;                 // ...unless this cap is hit (huge ellipses)
+  // Every corner of the outer region lies within this distance of the hull of the
+  // confidence ellipses...
+  double max_polygon_error_px = 0.5;
+  int max_outer_corners = 256;  // ...unless this cap is hit (enormous ellipses)
 };
 
 // ---- Expansion and contraction (regions.cpp) ----
