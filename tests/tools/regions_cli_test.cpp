@@ -152,3 +152,23 @@ TEST(RegionsCli, EveryShippedSceneGivesARegionForEveryObject) {
   }
   EXPECT_GE(scenes, 2);
 }
+
+TEST(RegionsCli, ObjectBehindTheCameraIsFlaggedNotProjected) {
+  const std::filesystem::path scene = std::filesystem::temp_directory_path() / "covtrack_behind.toml";
+  std::ofstream(scene) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR
+                          "/config/cameras/example_640x480.yml\"\n"
+                          "[[transform]]\nparent = \"camera\"\nchild = \"thing\"\nposition_m = [0, 0, -2]\n"
+                          "sigma_m = [0.01, 0.01, 0.01]\nsigma_rad = [0.01, 0.01, 0.01]\n"
+                          "[[object]]\nname = \"behind\"\nframe = \"thing\"\nbox_m = [0.2, 0.2, 0.2]\n";
+  const CliRun r = run(scene.string() + " --json");
+  std::filesystem::remove(scene);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const nlohmann::json doc = nlohmann::json::parse(r.out, nullptr, false);
+  ASSERT_FALSE(doc.is_discarded()) << r.out;
+  const auto& o = doc["objects"][0];
+  EXPECT_FALSE(o["valid"].get<bool>());
+  EXPECT_TRUE(o["assessment_px"].is_null());
+  EXPECT_EQ(o["flags"], nlohmann::json::array({"behind_camera"}));
+  EXPECT_TRUE(o["outer_px"].empty());
+  for (const auto& v : o["vertices"]) EXPECT_TRUE(v["mean_px"].is_null());
+}

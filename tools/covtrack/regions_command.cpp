@@ -48,11 +48,16 @@ nlohmann::json object_json(const RegionsReport::Object& o) {
     const client::ProjectedVertex& v = o.regions.vertices[i];
     const Vec3& p = o.hull_vertices_m[i];
     const client::Mat2& c = v.covariance_px2;
-    vertices.push_back({{"vertex_m", {p.x(), p.y(), p.z()}},
-                        {"mean_px", {v.mean_px.x(), v.mean_px.y()}},
-                        {"covariance_px2", {{c(0, 0), c(0, 1)}, {c(1, 0), c(1, 1)}}},
-                        {"depth_m", v.depth_m},
-                        {"flags", flag_names(v.flags)}});
+    nlohmann::json vertex = {{"vertex_m", {p.x(), p.y(), p.z()}},
+                             {"mean_px", nullptr},
+                             {"covariance_px2", nullptr},
+                             {"depth_m", v.depth_m},
+                             {"flags", flag_names(v.flags)}};
+    if (v.flags.usable()) {  // otherwise there is no pixel, or no covariance, to give
+      vertex["mean_px"] = {v.mean_px.x(), v.mean_px.y()};
+      vertex["covariance_px2"] = {{c(0, 0), c(0, 1)}, {c(1, 0), c(1, 1)}};
+    }
+    vertices.push_back(vertex);
   }
   const double a = o.regions.assessment;
   return {{"name", o.name},
@@ -85,12 +90,18 @@ void print_text(const RegionsReport& report) {
     for (std::size_t i = 0; i < r.vertices.size(); ++i) {
       const client::ProjectedVertex& v = r.vertices[i];
       const client::Mat2& c = v.covariance_px2;
+      if (!v.flags.usable()) {
+        fmt::print("  vertex {:2} no pixel [{}]  depth {:.2f} m\n", i, fmt::join(flag_names(v.flags), ", "), v.depth_m);
+        continue;
+      }
       fmt::print("  vertex {:2} pixel ({:7.1f}, {:7.1f})  cov px^2 [{:.3g} {:.3g}; {:.3g} {:.3g}]  depth {:.2f} m\n",
                  i, v.mean_px.x(), v.mean_px.y(), c(0, 0), c(0, 1), c(1, 0), c(1, 1), v.depth_m);
     }
     if (!r.valid) continue;
     fmt::print("  outer ({} points):{}\n", r.outer.size(), polygon_text(r.outer));
-    if (r.inner.empty())
+    if (r.hull.size() < 3)
+      fmt::print("  inner: none (the object covers no area on the screen)\n");
+    else if (r.inner.empty())
       fmt::print("  inner: empty (the error swamps the object)\n");
     else
       fmt::print("  inner ({} points):{}\n", r.inner.size(), polygon_text(r.inner));
