@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   covtrack::cli::add_record_command(app);
   covtrack::cli::add_replay_command(app);
   covtrack::cli::add_regions_command(app);
+  covtrack::cli::add_view_command(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

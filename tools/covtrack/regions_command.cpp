@@ -9,8 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "covtrack/protocol/clock.hpp"
 #include "covtrack/scene/scene.hpp"
-#include "regions_png.hpp"
+#include "region_drawing.hpp"
 #include "regions_report.hpp"
 
 namespace covtrack::cli {
@@ -117,10 +118,21 @@ int run_regions(const RegionsArgs& args) {
     std::cerr << "covtrack regions: a SCENE file is required (or --print-schema)\n";
     return 2;
   }
-  const auto report = compute_regions_report(args.scene_path, args.method, args.propagation,
-                                             args.confidence);
+  const auto model = load_regions_model(args.scene_path, args.confidence);
+  if (!model) {
+    std::cerr << "covtrack regions: " << model.error().message << "\n";
+    return 2;
+  }
+  // Tracked transforms take their scene values as reports measured now: no staleness.
+  const std::int64_t now = covtrack::now_us();
+  client::TransformGraph graph(args.propagation);
+  if (auto r = scene::add_scene_transforms(model->scene, graph, now); !r) {
+    std::cerr << "covtrack regions: " << args.scene_path << ": " << r.error().message << "\n";
+    return 2;
+  }
+  const auto report = compute_regions(*model, graph, now, args.method);
   if (!report) {
-    std::cerr << "covtrack regions: " << report.error().message << "\n";
+    std::cerr << "covtrack regions: " << args.scene_path << ": " << report.error().message << "\n";
     return 2;
   }
   if (args.json) {
@@ -136,7 +148,9 @@ int run_regions(const RegionsArgs& args) {
     print_text(*report);
   }
   if (!args.png_path.empty()) {
-    if (auto r = write_regions_png(*report, args.png_path); !r) {
+    cv::Mat image(report->camera.height_px, report->camera.width_px, CV_8UC3, cv::Scalar(40, 40, 40));
+    draw_regions(image, *report);
+    if (auto r = write_png(image, args.png_path); !r) {
       std::cerr << "covtrack regions: " << r.error().message << "\n";
       return 1;
     }

@@ -1,14 +1,28 @@
 #pragma once
-// A scene's objects through its camera: the regions `covtrack regions` prints and draws.
-// Tracked transforms take their scene values as fresh reports (the offline question).
+// A scene's objects through its camera: the regions `covtrack regions` prints and
+// `covtrack view` draws. The scene is loaded once (RegionsModel); regions are computed
+// per frame from a transform graph at a time.
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "covtrack/client/regions.hpp"
 #include "covtrack/client/transform_graph.hpp"
 #include "covtrack/protocol/result.hpp"
+#include "covtrack/scene/scene_graph.hpp"
 
 namespace covtrack::cli {
+
+struct RegionsModel {
+  std::string scene_path;
+  scene::Scene scene;
+  client::Camera camera;
+  double confidence = 0.95;
+  std::vector<scene::HullObject> objects;  // each object's 3-D hull, computed once
+};
+
+// confidence 0 takes the scene's. Errors name the scene file (and line, for its syntax).
+Result<RegionsModel> load_regions_model(const std::string& scene_path, double confidence);
 
 struct RegionsReport {
   struct Object {
@@ -23,9 +37,9 @@ struct RegionsReport {
   std::vector<Object> objects;
 };
 
-// confidence 0 takes the scene's. Errors name the scene file (and line, for its syntax).
-Result<RegionsReport> compute_regions_report(const std::string& scene_path,
-                                             client::ProjectionMethod method,
-                                             client::Propagation propagation, double confidence);
+// The regions of every object at time_us. Fails naming the object (not the file) if its
+// frame is not connected to the camera's.
+Result<RegionsReport> compute_regions(const RegionsModel& model, const client::TransformGraph& graph,
+                                      std::int64_t time_us, client::ProjectionMethod method);
 
 }  // namespace covtrack::cli

@@ -1,0 +1,192 @@
+// `covtrack view` as a user runs it: headless pictures checked pixel by pixel against the
+// regions `covtrack regions --json` reports, a video, a broken background, no display, and
+// live streams (published by this test inside its private network namespace).
+#include <sys/wait.h>
+
+#include <array>
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include <covtrack/pose_cov_t.hpp>
+
+#include "covtrack/protocol/channels.hpp"
+#include "covtrack/protocol/clock.hpp"
+#include "covtrack/protocol/pose_message.hpp"
+
+namespace {
+
+struct CliRun {
+  int exit_code;
+  std::string out;  // stdout and stderr together
+};
+
+CliRun run(const std::string& args, const std::string& env = "") {
+  const std::string cmd = env + " " + std::string(COVTRACK_CLI) + " " + args + " 2>&1";
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (!pipe) return {-1, "popen failed"};
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+const std::string kScene = COVTRACK_SOURCE_DIR "/config/scenes/head_and_world.toml";
+const std::filesystem::path kTmp = std::filesystem::temp_directory_path();
+
+bool inside(const nlohmann::json& polygon, double u, double v, double tolerance) {
+  const std::size_t n = polygon.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double au = polygon[i][0], av = polygon[i][1];
+    const double bu = polygon[(i + 1) % n][0], bv = polygon[(i + 1) % n][1];
+    if ((bu - au) * (v - av) - (bv - av) * (u - au) < -tolerance * std::hypot(bu - au, bv - av)) return false;
+  }
+  return n >= 3;
+}
+
+struct PixelCounts {
+  int green = 0;         // outer-region pixels
+  int white = 0;         // inner-region pixels
+  int white_astray = 0;  // inner-region pixels outside every outer region
+};
+
+bool is_green(const cv::Vec3b& p) { return p[1] > 150 && p[0] < 90 && p[2] < 90; }
+bool is_white(const cv::Vec3b& p) { return p[0] > 240 && p[1] > 240 && p[2] > 240; }
+
+PixelCounts count_pixels(const cv::Mat& image, const nlohmann::json& regions) {
+  PixelCounts c;
+  for (int y = 0; y < image.rows; ++y)
+    for (int x = 0; x < image.cols; ++x) {
+      const cv::Vec3b p = image.at<cv::Vec3b>(y, x);
+      c.green += is_green(p);
+      if (!is_white(p)) continue;
+      ++c.white;
+      bool in_some_outer = false;
+      for (const auto& o : regions["objects"]) in_some_outer = in_some_outer || inside(o["outer_px"], x, y, 2.0);
+      c.white_astray += !in_some_outer;
+    }
+  return c;
+}
+
+}  // namespace
+
+TEST(ViewCli, PictureShowsInnerRegionsInsideOuterRegions) {
+  const std::string png = (kTmp / "covtrack_view_test.png").string();
+  const CliRun view = run("view " + kScene + " --png " + png);
+  ASSERT_EQ(view.exit_code, 0) << view.out;
+  const CliRun regions = run("regions " + kScene + " --json");
+  ASSERT_EQ(regions.exit_code, 0) << regions.out;
+  const cv::Mat image = cv::imread(png, cv::IMREAD_COLOR);
+  ASSERT_FALSE(image.empty());
+  EXPECT_EQ(image.cols, 640);
+  const PixelCounts c = count_pixels(image, nlohmann::json::parse(regions.out));
+  std::printf("pixels: outer %d, inner %d, inner outside every outer %d\n", c.green, c.white, c.white_astray);
+  EXPECT_GT(c.green, 500);
+  EXPECT_GT(c.white, 300);
+  EXPECT_EQ(c.white_astray, 0);
+  std::filesystem::remove(png);
+}
+
+TEST(ViewCli, VideoHasTheFramesAsked) {
+  const std::string avi = (kTmp / "covtrack_view_test.avi").string();
+  const CliRun r = run("view " + kScene + " --video " + avi + " --duration 1 --fps 10");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  cv::VideoCapture video(avi, cv::CAP_FFMPEG);
+  ASSERT_TRUE(video.isOpened());
+  int frames = 0;
+  for (cv::Mat frame; video.read(frame);) {
+    ++frames;
+    EXPECT_EQ(frame.cols, 640);
+  }
+  EXPECT_GE(frames, 9);
+  EXPECT_LE(frames, 12);
+  std::filesystem::remove(avi);
+}
+
+TEST(ViewCli, CorruptBackgroundIsReportedAndTheViewGoesOn) {
+  const std::string bad = (kTmp / "covtrack_corrupt.avi").string();
+  std::ofstream(bad) << "RIFF\x10\0\0\0AVI garbage that is no video at all";
+  const std::string png = (kTmp / "covtrack_view_bg.png").string();
+  const CliRun r = run("view " + kScene + " --png " + png + " --background " + bad);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find(bad), std::string::npos) << r.out;
+  EXPECT_TRUE(std::filesystem::exists(png));
+  const CliRun camera = run("view " + kScene + " --png " + png + " --background camera:57");
+  EXPECT_EQ(camera.exit_code, 0) << camera.out;
+  EXPECT_NE(camera.out.find("camera:57"), std::string::npos) << camera.out;
+  std::filesystem::remove(bad);
+  std::filesystem::remove(png);
+}
+
+TEST(ViewCli, NoDisplayAndNoFileOutputIsAClearError) {
+  const CliRun r = run("view " + kScene, "env -u DISPLAY");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("--png"), std::string::npos) << r.out;
+}
+
+// A stream this test publishes: T_camera_thing 2 m ahead, so the object is on screen only
+// while the stream reports (the scene's value is not used with --live).
+TEST(ViewCli, LiveStreamsDriveTheRegions) {
+  const std::filesystem::path scene = kTmp / "covtrack_live_scene.toml";
+  std::ofstream(scene) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR
+                          "/config/cameras/example_640x480.yml\"\n"
+                          "[[transform]]\nparent = \"camera\"\nchild = \"thing\"\nposition_m = [0, 0, 2]\n"
+                          "sigma_m = [0.002, 0.002, 0.002]\nsigma_rad = [0.005, 0.005, 0.005]\n"
+                          "stream = \"viewtest/thing\"\n"
+                          "[[object]]\nname = \"thing\"\nframe = \"thing\"\nbox_m = [0.4, 0.3, 0.01]\n";
+  lcm::LCM lcm;
+  ASSERT_TRUE(lcm.good());
+  std::atomic<bool> stop{false}, lost{false};
+  std::thread publisher([&] {
+    for (std::int64_t seq = 0; !stop; ++seq) {
+      covtrack::pose_cov_t m{};
+      m.device = "viewtest";
+      m.sensor = "thing";
+      m.parent_frame = "camera";
+      m.child_frame = "thing";
+      m.sequence = seq;
+      m.measurement_time_us = m.publish_time_us = covtrack::now_us();
+      covtrack::Pose T = covtrack::Pose::Identity();
+      T.translation() = covtrack::Vec3(0, 0, 2);
+      covtrack::Mat6 C = covtrack::Mat6::Zero();
+      C.diagonal() << 4e-6, 4e-6, 4e-6, 2.5e-5, 2.5e-5, 2.5e-5;
+      covtrack::set_pose(m, T, C);
+      m.status = lost ? covtrack::pose_cov_t::STATUS_LOST : covtrack::pose_cov_t::STATUS_OK;
+      if (lost) {
+        for (int i = 0; i < 36; i += 7) m.covariance[i] = std::numeric_limits<double>::infinity();
+      }
+      lcm.publish(covtrack::pose_channel("viewtest", "thing"), &m);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  const std::string png = (kTmp / "covtrack_view_live.png").string();
+  const auto green_pixels = [&] {
+    const CliRun r = run("view " + scene.string() + " --live --png " + png + " --duration 1.5");
+    EXPECT_EQ(r.exit_code, 0) << r.out;
+    const cv::Mat image = cv::imread(png, cv::IMREAD_COLOR);
+    int green = 0;
+    for (int y = 0; y < image.rows; ++y)
+      for (int x = 0; x < image.cols; ++x) green += is_green(image.at<cv::Vec3b>(y, x));
+    return green;
+  };
+  const int reporting = green_pixels();
+  lost = true;
+  const int lost_stream = green_pixels();
+  stop = true;
+  publisher.join();
+  std::printf("outer-region pixels: stream reporting %d, stream LOST %d\n", reporting, lost_stream);
+  EXPECT_GT(reporting, 300);
+  EXPECT_EQ(lost_stream, 0);
+  std::filesystem::remove(png);
+  std::filesystem::remove(scene);
+}

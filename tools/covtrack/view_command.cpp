@@ -1,0 +1,159 @@
+// `covtrack view SCENE`: every object's registration error drawn over the camera view,
+// from the scene's fixed values or, with --live, from the daemon's streams (tracked
+// edges grow with report age, so latency shows as error). Output: a window when a
+// display exists, else one PNG (--png) or a video (--video).
+#include <chrono>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <thread>
+
+#include <opencv2/highgui.hpp>
+#include <opencv2/videoio.hpp>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "covtrack/client/subscriber.hpp"
+#include "covtrack/protocol/clock.hpp"
+#include "region_drawing.hpp"
+#include "regions_report.hpp"
+#include "stop_signal.hpp"
+#include "view_background.hpp"
+
+namespace covtrack::cli {
+namespace {
+
+struct ViewArgs {
+  std::string scene_path;
+  bool live = false;
+  std::string lcm_url;
+  std::string png_path;
+  std::string video_path;
+  std::string background;
+  double duration_s = 0;  // 0: until stopped (window), one frame (--png), 10 s (--video)
+  double fps = 30;
+  double confidence = 0;
+  client::ProjectionMethod method = client::ProjectionMethod::unscented;
+};
+
+// One line per tracked transform: where its value comes from and how old it is.
+std::vector<std::string> legend_lines(const RegionsModel& model, const ViewArgs& args,
+                                      const client::Subscriber* subscriber, std::int64_t now) {
+  std::vector<std::string> lines = {
+      fmt::format("{:.0f}% regions: ellipses blue, outer green, inner white", 100 * model.confidence)};
+  for (const scene::SceneTransform& t : model.scene.transforms) {
+    if (!t.stream) continue;
+    std::string state = "fixed scene value";
+    if (subscriber) {
+      const auto latest = subscriber->latest(*t.stream);
+      state = latest ? fmt::format("{} {:.0f} ms old", to_string(latest->status), latest->age_s(now) * 1e3)
+                     : std::string("no report: LOST");
+    }
+    lines.push_back(fmt::format("{} -> {} [{}]: {}", t.parent, t.child, t.stream->key(), state));
+  }
+  return lines;
+}
+
+int run_view(const ViewArgs& args) {
+  const auto fail_with = [](const std::string& message, int code) {
+    std::cerr << "covtrack view: " << message << "\n";
+    return code;
+  };
+  const bool window = args.png_path.empty() && args.video_path.empty();
+  if (window && !std::getenv("DISPLAY"))
+    return fail_with("no display (DISPLAY is not set): use --png FILE or --video FILE", 2);
+  const auto model = load_regions_model(args.scene_path, args.confidence);
+  if (!model) return fail_with(model.error().message, 2);
+
+  client::TransformGraph graph;
+  std::unique_ptr<client::Subscriber> subscriber;
+  const std::optional<std::int64_t> fixed_at =
+      args.live ? std::nullopt : std::optional<std::int64_t>(covtrack::now_us());
+  if (auto r = scene::add_scene_transforms(model->scene, graph, fixed_at); !r)
+    return fail_with(fmt::format("{}: {}", args.scene_path, r.error().message), 2);
+  if (args.live) {
+    auto sub = client::Subscriber::open({.lcm_url = args.lcm_url});
+    if (!sub) return fail_with(sub.error().message, 2);
+    subscriber = std::move(*sub);
+    // Streams the scene does not use are simply not in the graph.
+    (void)subscriber->on_pose(".*", [&graph](const client::TrackedTransform& t) { (void)graph.update(t.stream, t); });
+  }
+
+  const cv::Size size(model->camera.width_px, model->camera.height_px);
+  std::string warning;
+  ViewBackground background(args.background, size, warning);
+  std::optional<cv::VideoWriter> video;
+  if (!args.video_path.empty()) {
+    video.emplace(args.video_path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), args.fps, size);
+    if (!video->isOpened()) return fail_with(fmt::format("cannot write video {}", args.video_path), 1);
+  }
+  if (window) cv::namedWindow("covtrack view", cv::WINDOW_AUTOSIZE);
+
+  install_stop_signals();
+  const double duration_s = args.duration_s > 0 ? args.duration_s : (video ? 10.0 : 0.0);
+  const auto start = std::chrono::steady_clock::now();
+  const auto period = std::chrono::duration<double>(1.0 / args.fps);
+  for (long frame_index = 0;; ++frame_index) {
+    const auto due = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(frame_index * period);
+    std::this_thread::sleep_until(due);
+    const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s);
+    // --png takes its one frame at the end of --duration (live streams have arrived by then).
+    if (!args.png_path.empty() && !last && duration_s > 0) continue;
+
+    const std::int64_t now = covtrack::now_us();
+    // Fixed scene values are as fresh as when they were set: no staleness grows on them.
+    const auto report = compute_regions(*model, graph, fixed_at.value_or(now), args.method);
+    if (!report) return fail_with(fmt::format("{}: {}", args.scene_path, report.error().message), 2);
+    cv::Mat image = background.next(warning);
+    if (!warning.empty()) {
+      std::cerr << "covtrack view: " << warning << "\n";
+      warning.clear();
+    }
+    draw_regions(image, *report);
+    draw_legend(image, legend_lines(*model, args, subscriber.get(), now));
+
+    if (!args.png_path.empty()) {
+      if (auto r = write_png(image, args.png_path); !r) return fail_with(r.error().message, 1);
+      return 0;
+    }
+    if (video) video->write(image);
+    if (window) {
+      cv::imshow("covtrack view", image);
+      const int key = cv::waitKey(1);
+      if (key == 'q' || key == 27 || cv::getWindowProperty("covtrack view", cv::WND_PROP_VISIBLE) < 1) break;
+    }
+    if (last) break;
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_view_command(CLI::App& app) {
+  auto args = std::make_shared<ViewArgs>();
+  auto* cmd = app.add_subcommand("view", "Draw the objects' error regions over the camera view");
+  cmd->add_option("SCENE", args->scene_path, "Scene file (config/scene_schema.md)")->required();
+  cmd->add_flag("--live", args->live, "Tracked transforms from the daemon's streams, not the scene's values");
+  cmd->add_option("--lcm-url", args->lcm_url, "LCM URL for --live (default: $LCM_DEFAULT_URL or LCM's)");
+  cmd->add_option("--png", args->png_path, "Write one frame (at the end of --duration, if given) and exit");
+  cmd->add_option("--video", args->video_path, "Write the frames to this video file (MJPG AVI)");
+  cmd->add_option("--background", args->background,
+                  "#rrggbb, an image file, a video file (looped) or camera:N");
+  cmd->add_option("--duration", args->duration_s, "Seconds to run (default: until q/Esc/Ctrl-C; 10 for --video)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--fps", args->fps, "Frames per second")->capture_default_str()->check(CLI::Range(0.1, 240.0));
+  cmd->add_option("--confidence", args->confidence, "Confidence of the regions (default: the scene's)")
+      ->check(CLI::Range(0.5, 0.9999));
+  const std::map<std::string, client::ProjectionMethod> methods = {
+      {"unscented", client::ProjectionMethod::unscented}, {"linear", client::ProjectionMethod::linear}};
+  cmd->add_option("--method", args->method, "Vertex projection: unscented or linear")
+      ->transform(CLI::CheckedTransformer(methods));
+  cmd->callback([args] {
+    if (const int code = run_view(*args); code != 0) throw CLI::RuntimeError(code);
+  });
+}
+
+}  // namespace covtrack::cli
