@@ -19,6 +19,7 @@
 
 #include <covtrack/pose_cov_t.hpp>
 
+#include "covtrack/lcmlog/log_writer.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/pose_message.hpp"
@@ -78,6 +79,50 @@ PixelCounts count_pixels(const cv::Mat& image, const nlohmann::json& regions) {
   return c;
 }
 
+covtrack::pose_cov_t thing_message(std::int64_t seq, std::int64_t time_us, bool lost) {
+  covtrack::pose_cov_t m{};
+  m.device = "viewtest";
+  m.sensor = "thing";
+  m.parent_frame = "camera";
+  m.child_frame = "thing";
+  m.sequence = seq;
+  m.measurement_time_us = m.publish_time_us = time_us;
+  covtrack::Pose T = covtrack::Pose::Identity();
+  T.translation() = covtrack::Vec3(0, 0, 2);
+  covtrack::Mat6 C = covtrack::Mat6::Zero();
+  C.diagonal() << 4e-6, 4e-6, 4e-6, 2.5e-5, 2.5e-5, 2.5e-5;
+  covtrack::set_pose(m, T, C);
+  m.status = lost ? covtrack::pose_cov_t::STATUS_LOST : covtrack::pose_cov_t::STATUS_OK;
+  if (lost) {
+    for (int i = 0; i < 36; i += 7) m.covariance[i] = std::numeric_limits<double>::infinity();
+  }
+  return m;
+}
+
+// A scene whose only object, 2 m ahead of the camera, hangs on the stream viewtest/thing.
+std::filesystem::path write_thing_scene() {
+  const std::filesystem::path scene = kTmp / "covtrack_thing_scene.toml";
+  std::ofstream(scene) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR
+                          "/config/cameras/example_640x480.yml\"\n"
+                          "[[transform]]\nparent = \"camera\"\nchild = \"thing\"\nposition_m = [0, 0, 2]\n"
+                          "sigma_m = [0.002, 0.002, 0.002]\nsigma_rad = [0.005, 0.005, 0.005]\n"
+                          "stream = \"viewtest/thing\"\n"
+                          "[[object]]\nname = \"thing\"\nframe = \"thing\"\nbox_m = [0.4, 0.3, 0.01]\n";
+  return scene;
+}
+
+int green_pixels_of(const std::string& args) {
+  const std::string png = (kTmp / "covtrack_view_green.png").string();
+  const CliRun r = run("view " + args + " --png " + png);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  const cv::Mat image = cv::imread(png, cv::IMREAD_COLOR);
+  int green = 0;
+  for (int y = 0; y < image.rows; ++y)
+    for (int x = 0; x < image.cols; ++x) green += is_green(image.at<cv::Vec3b>(y, x));
+  std::filesystem::remove(png);
+  return green;
+}
+
 }  // namespace
 
 TEST(ViewCli, PictureShowsInnerRegionsInsideOuterRegions) {
@@ -134,59 +179,58 @@ TEST(ViewCli, NoDisplayAndNoFileOutputIsAClearError) {
   EXPECT_NE(r.out.find("--png"), std::string::npos) << r.out;
 }
 
-// A stream this test publishes: T_camera_thing 2 m ahead, so the object is on screen only
-// while the stream reports (the scene's value is not used with --live).
+// A stream this test publishes: the object is on screen only while the stream reports
+// (the scene's value is not used with --live).
 TEST(ViewCli, LiveStreamsDriveTheRegions) {
-  const std::filesystem::path scene = kTmp / "covtrack_live_scene.toml";
-  std::ofstream(scene) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR
-                          "/config/cameras/example_640x480.yml\"\n"
-                          "[[transform]]\nparent = \"camera\"\nchild = \"thing\"\nposition_m = [0, 0, 2]\n"
-                          "sigma_m = [0.002, 0.002, 0.002]\nsigma_rad = [0.005, 0.005, 0.005]\n"
-                          "stream = \"viewtest/thing\"\n"
-                          "[[object]]\nname = \"thing\"\nframe = \"thing\"\nbox_m = [0.4, 0.3, 0.01]\n";
+  const std::filesystem::path scene = write_thing_scene();
   lcm::LCM lcm;
   ASSERT_TRUE(lcm.good());
   std::atomic<bool> stop{false}, lost{false};
   std::thread publisher([&] {
     for (std::int64_t seq = 0; !stop; ++seq) {
-      covtrack::pose_cov_t m{};
-      m.device = "viewtest";
-      m.sensor = "thing";
-      m.parent_frame = "camera";
-      m.child_frame = "thing";
-      m.sequence = seq;
-      m.measurement_time_us = m.publish_time_us = covtrack::now_us();
-      covtrack::Pose T = covtrack::Pose::Identity();
-      T.translation() = covtrack::Vec3(0, 0, 2);
-      covtrack::Mat6 C = covtrack::Mat6::Zero();
-      C.diagonal() << 4e-6, 4e-6, 4e-6, 2.5e-5, 2.5e-5, 2.5e-5;
-      covtrack::set_pose(m, T, C);
-      m.status = lost ? covtrack::pose_cov_t::STATUS_LOST : covtrack::pose_cov_t::STATUS_OK;
-      if (lost) {
-        for (int i = 0; i < 36; i += 7) m.covariance[i] = std::numeric_limits<double>::infinity();
-      }
+      const covtrack::pose_cov_t m = thing_message(seq, covtrack::now_us(), lost);
       lcm.publish(covtrack::pose_channel("viewtest", "thing"), &m);
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   });
-  const std::string png = (kTmp / "covtrack_view_live.png").string();
-  const auto green_pixels = [&] {
-    const CliRun r = run("view " + scene.string() + " --live --png " + png + " --duration 1.5");
-    EXPECT_EQ(r.exit_code, 0) << r.out;
-    const cv::Mat image = cv::imread(png, cv::IMREAD_COLOR);
-    int green = 0;
-    for (int y = 0; y < image.rows; ++y)
-      for (int x = 0; x < image.cols; ++x) green += is_green(image.at<cv::Vec3b>(y, x));
-    return green;
-  };
-  const int reporting = green_pixels();
+  const std::string args = scene.string() + " --live --duration 1.5";
+  const int reporting = green_pixels_of(args);
   lost = true;
-  const int lost_stream = green_pixels();
+  const int lost_stream = green_pixels_of(args);
   stop = true;
   publisher.join();
   std::printf("outer-region pixels: stream reporting %d, stream LOST %d\n", reporting, lost_stream);
   EXPECT_GT(reporting, 300);
   EXPECT_EQ(lost_stream, 0);
-  std::filesystem::remove(png);
+  std::filesystem::remove(scene);
+}
+
+// A recorded session: one second of reports, then one second LOST. The view follows the
+// log's time, so a picture at 0.5 s shows the object and one at 1.6 s does not.
+TEST(ViewCli, LogIsFollowedAtItsOwnTime) {
+  const std::filesystem::path scene = write_thing_scene();
+  const std::string log_path = (kTmp / "covtrack_view_session.lcm").string();
+  {
+    auto log = covtrack::lcmlog::LogWriter::create(log_path, true);
+    ASSERT_TRUE(log) << log.error().message;
+    const std::int64_t t0 = 1'700'000'000'000'000;
+    for (int i = 0; i < 100; ++i) {
+      const std::int64_t t = t0 + i * 20'000;
+      const covtrack::pose_cov_t m = thing_message(i, t, i >= 50);
+      std::vector<std::byte> bytes(m.getEncodedSize());
+      m.encode(bytes.data(), 0, int(bytes.size()));
+      ASSERT_TRUE(log->write(t, covtrack::pose_channel("viewtest", "thing"), bytes));
+    }
+  }
+  const int early = green_pixels_of(scene.string() + " --log " + log_path + " --duration 0.5");
+  const int late = green_pixels_of(scene.string() + " --log " + log_path + " --duration 0.8 --speed 2");
+  std::printf("outer-region pixels: log at 0.5 s %d, at 1.6 s %d\n", early, late);
+  EXPECT_GT(early, 300);
+  EXPECT_EQ(late, 0);
+
+  const CliRun missing = run("view " + scene.string() + " --log /nonexistent/session.lcm --png /tmp/x.png");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.out.find("/nonexistent/session.lcm"), std::string::npos) << missing.out;
+  std::filesystem::remove(log_path);
   std::filesystem::remove(scene);
 }

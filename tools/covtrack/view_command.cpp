@@ -1,9 +1,12 @@
 // `covtrack view SCENE`: every object's registration error drawn over the camera view,
-// from the scene's fixed values or, with --live, from the daemon's streams (tracked
-// edges grow with report age, so latency shows as error). Output: a window when a
-// display exists, else one PNG (--png) or a video (--video).
+// from the scene's fixed values, or from the daemon's streams (--live), or from a
+// recorded session at its own time (--log); tracked edges grow with report age, so
+// latency shows as error. Output: a window when a display exists, else one PNG (--png)
+// or a video (--video).
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -21,6 +24,7 @@
 #include "regions_report.hpp"
 #include "stop_signal.hpp"
 #include "view_background.hpp"
+#include "view_log.hpp"
 
 namespace covtrack::cli {
 namespace {
@@ -29,6 +33,8 @@ struct ViewArgs {
   std::string scene_path;
   bool live = false;
   std::string lcm_url;
+  std::string log_path;
+  double speed = 1;
   std::string png_path;
   std::string video_path;
   std::string background;
@@ -38,16 +44,18 @@ struct ViewArgs {
   client::ProjectionMethod method = client::ProjectionMethod::unscented;
 };
 
+using LatestReport = std::function<std::optional<client::TrackedTransform>(const StreamId&)>;
+
 // One line per tracked transform: where its value comes from and how old it is.
-std::vector<std::string> legend_lines(const RegionsModel& model, const ViewArgs& args,
-                                      const client::Subscriber* subscriber, std::int64_t now) {
+std::vector<std::string> legend_lines(const RegionsModel& model, const LatestReport& latest_report,
+                                      std::int64_t now) {
   std::vector<std::string> lines = {
       fmt::format("{:.0f}% regions: ellipses blue, outer green, inner white", 100 * model.confidence)};
   for (const scene::SceneTransform& t : model.scene.transforms) {
     if (!t.stream) continue;
     std::string state = "fixed scene value";
-    if (subscriber) {
-      const auto latest = subscriber->latest(*t.stream);
+    if (latest_report) {
+      const auto latest = latest_report(*t.stream);
       state = latest ? fmt::format("{} {:.0f} ms old", to_string(latest->status), latest->age_s(now) * 1e3)
                      : std::string("no report: LOST");
     }
@@ -67,10 +75,14 @@ int run_view(const ViewArgs& args) {
   const auto model = load_regions_model(args.scene_path, args.confidence);
   if (!model) return fail_with(model.error().message, 2);
 
+  if (args.live && !args.log_path.empty()) return fail_with("--live and --log exclude each other", 2);
   client::TransformGraph graph;
   std::unique_ptr<client::Subscriber> subscriber;
+  std::optional<LogFollower> log;
+  LatestReport latest_report;  // none: the scene's fixed values
+  const bool fixed = !args.live && args.log_path.empty();
   const std::optional<std::int64_t> fixed_at =
-      args.live ? std::nullopt : std::optional<std::int64_t>(covtrack::now_us());
+      fixed ? std::optional<std::int64_t>(covtrack::now_us()) : std::nullopt;
   if (auto r = scene::add_scene_transforms(model->scene, graph, fixed_at); !r)
     return fail_with(fmt::format("{}: {}", args.scene_path, r.error().message), 2);
   if (args.live) {
@@ -79,6 +91,13 @@ int run_view(const ViewArgs& args) {
     subscriber = std::move(*sub);
     // Streams the scene does not use are simply not in the graph.
     (void)subscriber->on_pose(".*", [&graph](const client::TrackedTransform& t) { (void)graph.update(t.stream, t); });
+    latest_report = [&subscriber](const StreamId& id) { return subscriber->latest(id); };
+  }
+  if (!args.log_path.empty()) {
+    auto opened = LogFollower::open(args.log_path);
+    if (!opened) return fail_with(opened.error().message, 2);
+    log.emplace(std::move(*opened));
+    latest_report = [&log](const StreamId& id) { return log->latest(id); };
   }
 
   const cv::Size size(model->camera.width_px, model->camera.height_px);
@@ -99,13 +118,19 @@ int run_view(const ViewArgs& args) {
     const auto due = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(frame_index * period);
     std::this_thread::sleep_until(due);
     const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s);
+    // The log's clock runs at --speed from its first event.
+    const std::optional<std::int64_t> log_time =
+        log ? std::optional<std::int64_t>(log->start_us() + std::llround(elapsed_s * args.speed * 1e6))
+            : std::nullopt;
+    if (log) log->advance_to(*log_time, graph);
+    const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s) ||
+                      (log && log->finished());
     // --png takes its one frame at the end of --duration (live streams have arrived by then).
     if (!args.png_path.empty() && !last && duration_s > 0) continue;
 
-    const std::int64_t now = covtrack::now_us();
     // Fixed scene values are as fresh as when they were set: no staleness grows on them.
-    const auto report = compute_regions(*model, graph, fixed_at.value_or(now), args.method);
+    const std::int64_t now = log_time ? *log_time : fixed_at.value_or(covtrack::now_us());
+    const auto report = compute_regions(*model, graph, now, args.method);
     if (!report) return fail_with(fmt::format("{}: {}", args.scene_path, report.error().message), 2);
     cv::Mat image = background.next(warning);
     if (!warning.empty()) {
@@ -113,7 +138,7 @@ int run_view(const ViewArgs& args) {
       warning.clear();
     }
     draw_regions(image, *report);
-    draw_legend(image, legend_lines(*model, args, subscriber.get(), now));
+    draw_legend(image, legend_lines(*model, latest_report, now));
 
     if (!args.png_path.empty()) {
       if (auto r = write_png(image, args.png_path); !r) return fail_with(r.error().message, 1);
@@ -138,6 +163,8 @@ void add_view_command(CLI::App& app) {
   cmd->add_option("SCENE", args->scene_path, "Scene file (config/scene_schema.md)")->required();
   cmd->add_flag("--live", args->live, "Tracked transforms from the daemon's streams, not the scene's values");
   cmd->add_option("--lcm-url", args->lcm_url, "LCM URL for --live (default: $LCM_DEFAULT_URL or LCM's)");
+  cmd->add_option("--log", args->log_path, "Follow a recorded session (LCM log) at its own time");
+  cmd->add_option("--speed", args->speed, "Speed factor of --log")->capture_default_str()->check(CLI::Range(0.01, 1000.0));
   cmd->add_option("--png", args->png_path, "Write one frame (at the end of --duration, if given) and exit");
   cmd->add_option("--video", args->video_path, "Write the frames to this video file (MJPG AVI)");
   cmd->add_option("--background", args->background,
