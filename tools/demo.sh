@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The quick-start demo: covtrackd with the simulated trackers of config/sim.toml, and
-# `covtrack echo` showing their streams live. Ctrl-C ends both.
+# `covtrack echo` showing their streams live; with a display, `covtrack view` also draws
+# the registration error of config/scenes/sim_lab.toml live. Ctrl-C ends them all.
 #
 # Both run inside a private network namespace whose only interface is loopback, so the
 # demo works on any machine (no multicast route needed) and sends nothing outside it.
@@ -15,6 +16,10 @@ if [ "${COVTRACK_DEMO_IN_NETNS:-0}" != 1 ]; then
 fi
 
 build/server/covtrackd --config "$config" --log-level warn &
-daemon=$!
-trap 'kill -TERM $daemon 2>/dev/null; wait $daemon 2>/dev/null' EXIT
+pids=$!
+trap 'kill -TERM $pids 2>/dev/null; wait $pids 2>/dev/null' EXIT
+if [ -n "${DISPLAY:-}" ] && [ "$config" = config/sim.toml ]; then
+  build/tools/covtrack/covtrack view config/scenes/sim_lab.toml --live &
+  pids="$pids $!"
+fi
 build/tools/covtrack/covtrack echo
