@@ -1,8 +1,6 @@
 // `covtrack regions` as a user runs it, on the shipped seed figure 10 scene: the JSON is
 // complete and self-consistent, the head-attached panel's error does not come from the
 // head tracker (unlike the seed's model), the picture is written, mistakes are reported.
-#include <sys/wait.h>
-
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -12,23 +10,13 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_support.hpp"
+
+using namespace covtrack::testing;
+
 namespace {
 
-struct CliRun {
-  int exit_code;
-  std::string out;  // stdout and stderr together
-};
-
-CliRun run(const std::string& args) {
-  const std::string cmd = std::string(COVTRACK_CLI) + " regions " + args + " 2>&1";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return {-1, "popen failed"};
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
-  const int status = ::pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+CliRun run(const std::string& args) { return run_covtrack("regions " + args); }
 
 const std::string kScene = COVTRACK_SOURCE_DIR "/config/scenes/head_and_world.toml";
 
@@ -44,18 +32,6 @@ const nlohmann::json& object(const nlohmann::json& doc, const std::string& name)
   static const nlohmann::json none;
   ADD_FAILURE() << "no object " << name;
   return none;
-}
-
-// Inside a counter-clockwise convex polygon (in u, v arithmetic), with a tolerance.
-bool inside(const nlohmann::json& polygon, double u, double v, double tolerance = 1e-6) {
-  const std::size_t n = polygon.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const double au = polygon[i][0], av = polygon[i][1];
-    const double bu = polygon[(i + 1) % n][0], bv = polygon[(i + 1) % n][1];
-    const double cross = (bu - au) * (v - av) - (bv - av) * (u - au);
-    if (cross < -tolerance * std::hypot(bu - au, bv - av)) return false;
-  }
-  return n >= 3;
 }
 
 }  // namespace
@@ -75,9 +51,9 @@ TEST(RegionsCli, JsonDescribesEveryHullVertexAndConsistentRegions) {
       EXPECT_DOUBLE_EQ(b, b2);
       EXPECT_GT(a, 0);
       EXPECT_GE(a * d - b * b, 0);
-      EXPECT_TRUE(inside(o["outer_px"], v["mean_px"][0], v["mean_px"][1]));
+      EXPECT_TRUE(json_polygon_contains(o["outer_px"], v["mean_px"][0], v["mean_px"][1], 1e-6));
     }
-    for (const auto& p : o["inner_px"]) EXPECT_TRUE(inside(o["outer_px"], p[0], p[1], 1e-3));
+    for (const auto& p : o["inner_px"]) EXPECT_TRUE(json_polygon_contains(o["outer_px"], p[0], p[1], 1e-3));
   }
 }
 

@@ -1,8 +1,6 @@
 // `covtrack view` as a user runs it: headless pictures checked pixel by pixel against the
 // regions `covtrack regions --json` reports, a video, a broken background, no display, and
 // live streams (published by this test inside its private network namespace).
-#include <sys/wait.h>
-
 #include <array>
 #include <atomic>
 #include <cstdio>
@@ -14,6 +12,8 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
+
+#include "cli_support.hpp"
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -24,36 +24,14 @@
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/pose_message.hpp"
 
+using namespace covtrack::testing;
+
 namespace {
 
-struct CliRun {
-  int exit_code;
-  std::string out;  // stdout and stderr together
-};
-
-CliRun run(const std::string& args, const std::string& env = "") {
-  const std::string cmd = env + " " + std::string(COVTRACK_CLI) + " " + args + " 2>&1";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return {-1, "popen failed"};
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
-  const int status = ::pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+CliRun run(const std::string& args, const std::string& env = "") { return run_covtrack(args, env); }
 
 const std::string kScene = COVTRACK_SOURCE_DIR "/config/scenes/head_and_world.toml";
 const std::filesystem::path kTmp = std::filesystem::temp_directory_path();
-
-bool inside(const nlohmann::json& polygon, double u, double v, double tolerance) {
-  const std::size_t n = polygon.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const double au = polygon[i][0], av = polygon[i][1];
-    const double bu = polygon[(i + 1) % n][0], bv = polygon[(i + 1) % n][1];
-    if ((bu - au) * (v - av) - (bv - av) * (u - au) < -tolerance * std::hypot(bu - au, bv - av)) return false;
-  }
-  return n >= 3;
-}
 
 struct PixelCounts {
   int green = 0;         // outer-region pixels
@@ -73,7 +51,7 @@ PixelCounts count_pixels(const cv::Mat& image, const nlohmann::json& regions) {
       if (!is_white(p)) continue;
       ++c.white;
       bool in_some_outer = false;
-      for (const auto& o : regions["objects"]) in_some_outer = in_some_outer || inside(o["outer_px"], x, y, 2.0);
+      for (const auto& o : regions["objects"]) in_some_outer = in_some_outer || json_polygon_contains(o["outer_px"], x, y, 2.0);
       c.white_astray += !in_some_outer;
     }
   return c;
