@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "delegated_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"covtrack: pose + covariance streams over LCM (see README.md)", "covtrack"};
@@ -9,8 +10,10 @@ int main(int argc, char** argv) {
   covtrack::cli::add_echo_command(app);
   covtrack::cli::add_record_command(app);
   covtrack::cli::add_replay_command(app);
-  covtrack::cli::add_regions_command(app);
-  covtrack::cli::add_view_command(app);
+  covtrack::cli::add_delegated_command(app, "regions", "Screen error regions of a scene's objects (offline)",
+                                       "covtrack-scene");
+  covtrack::cli::add_delegated_command(app, "view", "Draw the objects' error regions over the camera view",
+                                       "covtrack-scene");
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

@@ -1,0 +1,16 @@
+#pragma once
+// Subcommands that live in a sibling executable. `covtrack regions` and `covtrack view`
+// need OpenCV's image and video I/O, whose libraries pull in some 250 shared objects and
+// a second of start-up; kept out of `covtrack` itself, echo, record and replay start at
+// once. The user still types one command: `covtrack view ...` runs
+// `covtrack-scene view ...` from the same folder, with the same arguments.
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace covtrack::cli {
+
+void add_delegated_command(CLI::App& app, const std::string& name, const std::string& description,
+                           const std::string& executable);
+
+}  // namespace covtrack::cli
