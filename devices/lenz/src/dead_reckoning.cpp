@@ -91,9 +91,11 @@ AlongTrack DeadReckoner::estimate(double t_s) const {
   const double since = t_s - *entered_at_s_;  // the true time since the crossing is in [since, since + L]
   const double near = min_distance(v.lo, since);
   const double far = max_distance(v.hi, since + params_.crossing_latency_s);
-  // Certainly inside the occupied section: clip to it.
+  // Inside the occupied section, as last reported: the report may be up to the latency
+  // old, so the train may have gone past the end by what it covers in that time.
+  const double past_end = layout_.train().max_speed_mps * params_.crossing_latency_s;
   out.lo_s = sec.start_s + std::min(near, sec.length_m);
-  out.hi_s = sec.start_s + std::min(far, sec.length_m);
+  out.hi_s = sec.start_s + std::min(far, sec.length_m + past_end);
   return out;
 }
 
