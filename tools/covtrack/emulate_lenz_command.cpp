@@ -92,7 +92,7 @@ int run_emulate_lenz(const EmulateLenzArgs& args) {
   install_stop_signals();
   // Scripts and tests wait for this line: from here on the port can be opened.
   fmt::print(stderr, "covtrack emulate-lenz: {} on {} ({}), {} sections, {:.2f} m loop, profile cycle {:.1f} s\n",
-             args.interface, args.link, (*emulator)->device_path(), options.layout->sections().size(),
+             args.interface, args.link, (*emulator)->slave_path(), options.layout->sections().size(),
              options.layout->length_m(), (*emulator)->motion().cycle_s());
   std::jthread worker([&](std::stop_token stop) {
     (*emulator)->run(stop, lcm ? std::function<void(const TruthSample&)>(publish_truth) : nullptr);

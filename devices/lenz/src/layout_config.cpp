@@ -12,7 +12,7 @@ namespace covtrack::lenz {
 
 const TableSpec& layout_file_spec() {
   static const TableSpec spec{
-      "track layout file (lenz driver's `layout`)",
+      "track layout file (the lenz driver's layout key)",
       "lenz driver, covtrack emulate-lenz",
       {
           {"origin_m", ValueType::FloatArray, "m", "[0, 0, 0]", "where the first section starts", -1e4, 1e4, 3},
@@ -70,9 +70,9 @@ const TableSpec& layout_segment_spec() {
       "lenz driver, covtrack emulate-lenz",
       {
           {"kind", ValueType::String, "", "", "\"straight\" or \"arc\""},
-          {"length_m", ValueType::Float, "m", "", "straight: length along the track", 0.001, 1e3},
-          {"radius_m", ValueType::Float, "m", "", "arc: radius", 0.01, 1e3},
-          {"angle_deg", ValueType::Float, "deg", "", "arc: turn, positive to the left", -360, 360},
+          {"length_m", ValueType::Float, "m", "required for a straight", "straight: length along the track", 0.001, 1e3},
+          {"radius_m", ValueType::Float, "m", "required for an arc", "arc: radius", 0.01, 1e3},
+          {"angle_deg", ValueType::Float, "deg", "required for an arc", "arc: turn, positive to the left", -360, 360},
           {"rise_m", ValueType::Float, "m", "0", "height gained over the segment", -100, 100},
       }};
   return spec;
@@ -112,11 +112,14 @@ Segment read_segment(TableReader& r) {
   g.rise_m = r.number("rise_m", 0);
   if (kind == "straight") {
     g.kind = SegmentKind::Straight;
+    if (!r.has("length_m")) r.error("length_m", "required for a straight");
     g.length_m = r.number("length_m", 0.1);
     if (r.has("radius_m") || r.has("angle_deg")) r.error("kind", "a straight takes length_m, not radius_m/angle_deg");
     if (std::abs(g.rise_m) >= g.length_m) r.error("rise_m", "must be smaller than length_m");
   } else {
     g.kind = SegmentKind::Arc;
+    for (const char* key : {"radius_m", "angle_deg"})
+      if (!r.has(key)) r.error(key, "required for an arc");
     g.radius_m = r.number("radius_m", 1);
     g.angle_rad = r.number("angle_deg", 10) * kDeg;
     if (r.has("length_m")) r.error("length_m", "an arc takes radius_m and angle_deg; its length follows");

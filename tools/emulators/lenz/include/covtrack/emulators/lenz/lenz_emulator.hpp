@@ -41,6 +41,7 @@ class LenzEmulator {
 
   // The path a driver's `port` should name.
   std::string device_path() const { return pty_.device_path(); }
+  std::string slave_path() const { return pty_.slave_path(); }
   const TrainMotion& motion() const { return motion_; }
   const TrackLayout& layout() const { return *options_.layout; }
   // now_us() of the train's t = 0: the locomotive is at motion().s_at(now - start).
