@@ -7,6 +7,7 @@
 #include <deque>
 #include <fstream>
 #include <numbers>
+#include <iterator>
 #include <random>
 
 #include <Eigen/Eigenvalues>
@@ -102,6 +103,7 @@ namespace {
 struct HonestyFigures {
   int samples = 0, inside = 0, seed_inside = 0, pose_inside = 0;
   double width_sum = 0, error_sum = 0;
+  std::size_t inconsistencies = 0;
 };
 
 // Runs the train of the short test layout with the given profile for `seconds` of
@@ -166,6 +168,7 @@ HonestyFigures run_simulated(const TrackLayout& layout, const std::vector<SpeedS
     const Vec6 e = boxminus(layout.pose_at(s_true), layout.pose_at(est.mid_s()));
     f.pose_inside += e.dot(cov.ldlt().solve(e)) <= 16.812;
   }
+  f.inconsistencies = reckoner.inconsistencies();
   return f;
 }
 
@@ -193,6 +196,27 @@ TEST(LenzDeadReckoning, ContainsTheTruthThroughSpeedChangesAndStops) {
   const double mean_section_m = layout.length_m() / layout.sections().size();
   std::printf("mean interval width / mean section length: %.3f\n", mean_width / mean_section_m);
   EXPECT_LT(mean_width, mean_section_m);
+}
+
+TEST(LenzDeadReckoning, AReversibleTrainThatBacksUpIsStillContained) {
+  // The short layout with reversible = true, and a profile that backs up a little each lap.
+  std::ifstream in(std::string(COVTRACK_SOURCE_DIR) + "/tests/data/lenz_short_layout.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("[train]\n"), 8, "[train]\nreversible = true\n");
+  auto loaded = load_layout(write_temp("reversible.toml", text));
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  const std::vector<SpeedStep> profile{{0.4, 1}, {0, 0.5}, {-0.3, 0.8}, {0, 0.3}, {0.5, 1.5}, {0.1, 1}, {0, 0.5}};
+  const HonestyFigures f = run_simulated(*loaded, profile, 120);
+  ASSERT_GT(f.samples, 5000);
+  const double inside = double(f.inside) / f.samples;
+  std::printf("reversible: along-track 99%% interval holds the truth %.4f of %d samples; 6-D %.4f; "
+              "mean width %.4f m, mean |error| %.4f m\n",
+              inside, f.samples, double(f.pose_inside) / f.samples, f.width_sum / f.samples, f.error_sum / f.samples);
+  EXPECT_GE(inside, 0.99);
+  EXPECT_EQ(f.inconsistencies, 0u);
+  // The same run on the forward-only layout: each backing-up is an inconsistency.
+  const HonestyFigures forward_only = run_simulated(load("tests/data/lenz_short_layout.toml"), profile, 30);
+  EXPECT_GT(forward_only.inconsistencies, 0u);
 }
 
 TEST(LenzDeadReckoning, FirstReportStopsAndLossAreHandled) {

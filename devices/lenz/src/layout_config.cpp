@@ -33,6 +33,8 @@ const TableSpec& layout_train_spec() {
           {"max_speed_mps", ValueType::Float, "m/s", "", "the train never goes faster", 0.001, 100},
           {"max_accel_mps2", ValueType::Float, "m/s^2", "", "largest acceleration and deceleration "
            "(bounds how fast the speed can change between section boundaries)", 0.001, 100},
+          {"reversible", ValueType::Boolean, "", "false", "the train may also run backwards (against the "
+           "loop order); the dead reckoning then allows it to come back towards the boundary it crossed"},
           {"vehicles", ValueType::TableArray, "", "", "locomotive first, then the cars: see train.vehicles"},
       }};
   return spec;
@@ -145,6 +147,7 @@ Result<TrackLayout> load_layout(const std::string& path) {
     TableReader tr(*t, "train", layout_train_spec(), path, errors);
     train.max_speed_mps = tr.number("max_speed_mps", 1);
     train.max_accel_mps2 = tr.number("max_accel_mps2", 1);
+    train.reversible = tr.boolean("reversible", false);
     std::set<std::string> names;
     const auto vehicles = tr.tables("vehicles");
     for (std::size_t i = 0; i < vehicles.size(); ++i) {

@@ -1,5 +1,6 @@
 #include "covtrack/emulators/lenz/lenz_emulator.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -20,7 +21,12 @@ constexpr std::size_t kMaxPairsPerMessage = 7;  // header nibble 14 data bytes
 Result<std::unique_ptr<LenzEmulator>> LenzEmulator::create(LenzEmulatorOptions options) {
   if (!options.layout) return fail("lenz emulator: no layout");
   if (options.accel_mps2 <= 0) options.accel_mps2 = 0.8 * options.layout->train().max_accel_mps2;
-  for (auto& step : options.profile) step.speed_mps = std::min(step.speed_mps, options.layout->train().max_speed_mps);
+  const Train& train = options.layout->train();
+  for (auto& step : options.profile) {
+    if (step.speed_mps < 0 && !train.reversible)
+      return fail("lenz emulator: the profile runs backwards but the layout's train is not reversible");
+    step.speed_mps = std::clamp(step.speed_mps, -train.max_speed_mps, train.max_speed_mps);
+  }
   auto pty = serial::PseudoTerminal::create(options.link_path);
   if (!pty) return std::unexpected(pty.error());
   return std::unique_ptr<LenzEmulator>(new LenzEmulator(std::move(options), std::move(*pty)));

@@ -16,9 +16,10 @@ Result<std::vector<SpeedStep>> parse_speed_profile(const std::string& text) {
     SpeedStep step;
     char colon = 0;
     std::istringstream in(item);
-    if (!(in >> step.speed_mps >> colon >> step.hold_s) || colon != ':' || !in.eof() || step.speed_mps < 0 ||
-        step.hold_s < 0 || !std::isfinite(step.speed_mps) || !std::isfinite(step.hold_s))
-      return fail(fmt::format("speed profile item '{}': expected speed_mps:hold_s, both >= 0", item));
+    if (!(in >> step.speed_mps >> colon >> step.hold_s) || colon != ':' || !in.eof() || step.hold_s < 0 ||
+        !std::isfinite(step.speed_mps) || !std::isfinite(step.hold_s))
+      return fail(fmt::format("speed profile item '{}': expected speed_mps:hold_s (speed < 0: backwards, "
+                              "hold >= 0)", item));
     steps.push_back(step);
   }
   if (steps.empty()) return fail("speed profile is empty");
@@ -64,7 +65,7 @@ double TrainMotion::speed_at(double t) const {
   t = std::max(t, 0.0);
   const double tc = t - std::floor(t / cycle_s_) * cycle_s_;
   const Phase& p = phase_at(tc);
-  return std::max(0.0, p.v0 + p.accel * std::min(tc - p.t0, p.duration));
+  return p.v0 + p.accel * std::min(tc - p.t0, p.duration);
 }
 
 }  // namespace covtrack::lenz

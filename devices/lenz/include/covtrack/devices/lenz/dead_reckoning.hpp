@@ -11,7 +11,8 @@
 //   traversal time and the train's largest acceleration (a train that averaged v over
 //   T seconds ends between v - aT/2 and v + aT/2, never below 0 nor above v_max);
 // - from there it may slow down to a stop or speed up to v_max, at most at that
-//   acceleration, and never runs backwards;
+//   acceleration, and never runs backwards unless the layout says it may (then it may
+//   also come back towards the boundary it crossed, in either direction);
 // - and it is inside the occupied section.
 // The interval [lo, hi] therefore contains the truth whenever the train obeys its
 // limits; it is reported as a Gaussian whose 99% interval is exactly [lo, hi].
@@ -53,8 +54,8 @@ class DeadReckoner {
 
  private:
   struct SpeedRange { double lo = 0, hi = 0; };
-  SpeedRange speed_after(std::size_t section, double traversal_s) const;
-  void enter(std::size_t section, double t_s);
+  SpeedRange speed_after(std::size_t section, double traversal_s, bool same_direction) const;
+  void enter(std::size_t section, int direction, double t_s);
   void lose();
   double min_distance(double v, double t) const;
   double max_distance(double v, double t) const;
@@ -64,6 +65,7 @@ class DeadReckoner {
   std::optional<std::size_t> section_;
   std::optional<double> entered_at_s_;   // detection time of the crossing into section_
   std::optional<SpeedRange> entry_speed_;
+  int direction_ = +1;  // +1: in loop order; -1: backwards (reversible layouts only)
   std::size_t inconsistencies_ = 0;
 };
 

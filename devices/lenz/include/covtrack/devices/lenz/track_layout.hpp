@@ -43,6 +43,7 @@ struct Vehicle {
 struct Train {
   double max_speed_mps = 0;
   double max_accel_mps2 = 0;   // also the largest deceleration
+  bool reversible = false;     // may run backwards (against the loop order)
   std::vector<Vehicle> vehicles;  // the locomotive first
   // Distance from the locomotive's centre back to vehicle k's centre, along the track.
   double offset_behind_m(std::size_t k) const;

@@ -10,11 +10,11 @@
 namespace covtrack::lenz {
 
 struct SpeedStep {
-  double speed_mps = 0;
+  double speed_mps = 0;  // negative: backwards (only on a layout whose train is reversible)
   double hold_s = 0;  // time at that speed once reached
 };
 
-// "0.4:8,0.15:5,0:3" -> steps; an error names the bad item.
+// "0.4:8,0.15:5,0:3,-0.1:2" -> steps; an error names the bad item.
 Result<std::vector<SpeedStep>> parse_speed_profile(const std::string& text);
 
 class TrainMotion {
