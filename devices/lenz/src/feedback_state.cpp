@@ -31,4 +31,14 @@ void FeedbackState::reset() {
   known_.fill(0);
 }
 
+std::optional<std::vector<bool>> section_occupancy(const TrackLayout& layout, const FeedbackState& state) {
+  std::vector<bool> occupied;
+  for (const auto& s : layout.sections()) {
+    const auto in = state.input(s.input.module, s.input.input);
+    if (!in) return std::nullopt;
+    occupied.push_back(*in);
+  }
+  return occupied;
+}
+
 }  // namespace covtrack::lenz

@@ -117,7 +117,7 @@ class LenzDriver final : public Driver {
     for (const auto& frame : frames) {
       std::visit(overloaded{
                      [&](const Feedback& fb) {
-                       if (feedback_.apply(fb)) reckoner_.on_occupancy(occupancy(), now_s());
+                       if (feedback_.apply(fb)) reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_), now_s());
                      },
                      [&](const InterfaceNotice& n) {
                        if (n.code != 0x04 && n.code != 0x07) sink.count_error(describe_notice(n.code));
@@ -126,16 +126,6 @@ class LenzDriver final : public Driver {
                  },
                  interpret_reply(frame));
     }
-  }
-
-  std::optional<std::vector<bool>> occupancy() const {
-    std::vector<bool> occupied;
-    for (const auto& s : config_.layout->sections()) {
-      const auto in = feedback_.input(s.input.module, s.input.input);
-      if (!in) return std::nullopt;
-      occupied.push_back(*in);
-    }
-    return occupied;
   }
 
   void publish(SampleSink& sink, const AlongTrack& along) {

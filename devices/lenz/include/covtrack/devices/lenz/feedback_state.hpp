@@ -5,7 +5,9 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
+#include "covtrack/devices/lenz/track_layout.hpp"
 #include "covtrack/devices/lenz/xpressnet_messages.hpp"
 
 namespace covtrack::lenz {
@@ -22,5 +24,9 @@ class FeedbackState {
   std::array<std::uint8_t, 128> inputs_{};  // bit i = input i+1
   std::array<std::uint8_t, 128> known_{};   // bit 0: inputs 1-4 reported, bit 1: inputs 5-8
 };
+
+// Occupied or not for every section of the layout (in its order); nothing while some
+// section's input has not been reported yet.
+std::optional<std::vector<bool>> section_occupancy(const TrackLayout& layout, const FeedbackState& state);
 
 }  // namespace covtrack::lenz
