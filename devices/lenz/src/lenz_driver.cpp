@@ -103,7 +103,9 @@ class LenzDriver final : public Driver {
     const Prefix prefix = config_.interface == Interface::LiUsb ? Prefix::Reply : Prefix::None;  // FF FE
     const auto bytes = encode_frame(request_bytes(request), prefix);
     sink.raw(ByteDirection::ToDevice, bytes.data(), bytes.size());
-    return port.write_all(bytes, milliseconds(500));
+    // A few bytes take milliseconds even at 19200 baud; a longer wait means the interface
+    // holds CTS, and waiting on would delay noticing a stop request.
+    return port.write_all(bytes, milliseconds(80));
   }
 
   void handle_bytes(std::span<const std::uint8_t> bytes, SampleSink& sink) {
