@@ -15,6 +15,7 @@
 
 #include "covtrack/devices/lenz/dead_reckoning.hpp"
 #include "covtrack/devices/lenz/layout_config.hpp"
+#include "covtrack/devices/lenz/lenz_config.hpp"
 #include "covtrack/devices/lenz/train_poses.hpp"
 #include "covtrack/emulators/lenz/train_motion.hpp"
 
@@ -283,4 +284,47 @@ TEST(LenzPoseModel, LostIsInfiniteAndDegradedIsAValidCovariance) {
     EXPECT_TRUE(std::isinf(lost[k].covariance(0, 0)));
     EXPECT_TRUE(lost[k].T_parent_child.isApprox(poses[k].T_parent_child));  // the last estimate
   }
+}
+
+namespace {
+
+// Reads [devices.train] of `text` (as if from config/<name>) with the lenz driver's reader.
+std::pair<LenzConfig, ConfigErrors> read_device(const std::string& text) {
+  const std::string file = std::string(COVTRACK_SOURCE_DIR) + "/config/test_lenz.toml";
+  auto root = parse_toml(text, file);
+  EXPECT_TRUE(root) << root.error().message;
+  ConfigErrors errors;
+  const toml::table* device = (*root)["devices"]["train"].as_table();
+  TableReader r(*device, "devices.train", lenz_device_spec(), file, errors);
+  LenzConfig config = read_lenz_config(r, "train");
+  return {config, errors};
+}
+
+}  // namespace
+
+TEST(LenzConfig, TheExampleReadsAndTheLayoutPathIsRelativeToTheConfig) {
+  const auto [config, errors] = read_device(
+      "[devices.train]\ntype = \"lenz\"\nport = \"/dev/ttyUSB0\"\nlayout = \"lenz_layout.toml\"\n");
+  EXPECT_TRUE(errors.empty()) << errors.joined();
+  ASSERT_TRUE(config.layout);
+  EXPECT_EQ(config.layout->sections().size(), 10u);
+  EXPECT_EQ(config.baud, 19200);
+  EXPECT_TRUE(config.rts_cts);
+  const auto [usb, usb_errors] = read_device(
+      "[devices.train]\ntype = \"lenz\"\nport = \"/dev/ttyUSB0\"\ninterface = \"liusb\"\nlayout = \"lenz_layout.toml\"\n");
+  EXPECT_TRUE(usb_errors.empty()) << usb_errors.joined();
+  EXPECT_EQ(usb.baud, 57600);
+}
+
+TEST(LenzConfig, BadValuesAreReportedTogether) {
+  const auto [config, errors] = read_device(
+      "[devices.train]\ntype = \"lenz\"\ninterface = \"liusb\"\nbaud = 19200\nlayout = \"missing.toml\"\n"
+      "keepalive_s = 2\nlink_timeout_s = 1\nrate_hz = nan\n");
+  const std::string all = errors.joined();
+  EXPECT_NE(all.find("devices.train.port"), std::string::npos) << all;  // required
+  EXPECT_NE(all.find("LI-USB runs at 57600"), std::string::npos) << all;
+  EXPECT_NE(all.find("missing.toml: cannot read the file"), std::string::npos) << all;
+  EXPECT_NE(all.find("must be longer than keepalive_s"), std::string::npos) << all;
+  EXPECT_NE(all.find("devices.train.rate_hz"), std::string::npos) << all;  // not a finite number
+  EXPECT_NE(all.find("test_lenz.toml:"), std::string::npos) << all;
 }
