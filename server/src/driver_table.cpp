@@ -1,5 +1,7 @@
 #include "driver_table.hpp"
 
+#include "covtrack/devices/lenz/layout_config.hpp"
+#include "covtrack/devices/lenz/lenz_driver.hpp"
 #include "covtrack/devices/sim/sim_driver.hpp"
 
 namespace covtrack::server {
@@ -11,6 +13,16 @@ const std::vector<DriverType>& driver_types() {
        [](TableReader& device, const std::string& name) -> DriverFactory {
          sim::SimConfig config = sim::read_sim_config(device, name);
          return [config](std::uint64_t run) { return sim::make_sim_driver(config, run); };
+       }},
+      {"lenz", "Lenz Digital Plus train tracker (LI101F / LI-USB): section occupancy and dead reckoning, seed 7.3",
+       [] {
+         std::vector<const TableSpec*> specs{&lenz::lenz_device_spec()};
+         for (const auto* s : lenz::layout_specs()) specs.push_back(s);
+         return specs;
+       }(),
+       [](TableReader& device, const std::string& name) -> DriverFactory {
+         lenz::LenzConfig config = lenz::read_lenz_config(device, name);
+         return [config](std::uint64_t) { return lenz::make_lenz_driver(config); };
        }},
   };
   return table;

@@ -9,5 +9,6 @@ void add_record_command(CLI::App& app);
 void add_replay_command(CLI::App& app);
 void add_regions_command(CLI::App& app);
 void add_view_command(CLI::App& app);
+void add_emulate_lenz_command(CLI::App& app);
 
 }  // namespace covtrack::cli

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
                                        "covtrack-scene");
   covtrack::cli::add_delegated_command(app, "view", "Draw the objects' error regions over the camera view",
                                        "covtrack-scene");
+  covtrack::cli::add_emulate_lenz_command(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

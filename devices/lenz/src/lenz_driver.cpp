@@ -1,0 +1,161 @@
+#include "covtrack/devices/lenz/lenz_driver.hpp"
+
+#include <chrono>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "covtrack/devices/interruptible_sleep.hpp"
+#include "covtrack/devices/lenz/feedback_state.hpp"
+#include "covtrack/devices/lenz/xpressnet_framing.hpp"
+#include "covtrack/devices/lenz/xpressnet_messages.hpp"
+#include "covtrack/devices/serial/serial_port.hpp"
+#include "covtrack/protocol/clock.hpp"
+
+namespace covtrack::lenz {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using std::chrono::duration;
+using std::chrono::duration_cast;
+using std::chrono::milliseconds;
+
+template <class... F>
+struct overloaded : F... {
+  using F::operator()...;
+};
+
+double now_s() { return static_cast<double>(now_us()) * 1e-6; }
+
+Clock::duration seconds(double s) { return duration_cast<Clock::duration>(duration<double>(s)); }
+
+class LenzDriver final : public Driver {
+ public:
+  explicit LenzDriver(const LenzConfig& config)
+      : config_(config), reckoner_(*config.layout, config.reckoning), period_(seconds(1.0 / config.rate_hz)) {}
+
+  Result<void> run(SampleSink& sink, std::stop_token stop) override {
+    bool connected_before = false;
+    next_sample_ = Clock::now();
+    while (!stop.stop_requested()) {
+      auto port = serial::SerialPort::open({config_.port, config_.baud, config_.rts_cts});
+      if (!port) {
+        if (!connected_before) return std::unexpected(port.error());
+        sink.count_error(port.error().message);
+        publish_lost_for(sink, stop, seconds(config_.reconnect_s));
+        continue;
+      }
+      connected_before = true;
+      if (auto ended = session(**port, sink, stop); !ended) sink.count_error(ended.error().message);
+      // Crossings may be missed while the link is down: start the estimate afresh.
+      reckoner_.reset();
+      feedback_.reset();
+      decoder_.reset();
+    }
+    return {};
+  }
+
+ private:
+  // Talks to one open port until stop (success) or until the link fails (the error).
+  Result<void> session(serial::SerialPort& port, SampleSink& sink, std::stop_token stop) {
+    if (auto sent = send_startup(port, sink); !sent) return sent;
+    auto last_rx = Clock::now();
+    auto next_keepalive = Clock::now() + seconds(config_.keepalive_s);
+    std::uint8_t buffer[256];
+    while (!stop.stop_requested()) {
+      const auto wait = std::clamp(duration_cast<milliseconds>(next_sample_ - Clock::now()), milliseconds(0),
+                                   milliseconds(20));
+      auto got = port.read_some(buffer, wait);
+      if (!got) return std::unexpected(got.error());
+      const auto now = Clock::now();
+      if (*got > 0) {
+        last_rx = now;
+        sink.raw(ByteDirection::FromDevice, buffer, *got);
+        handle_bytes({buffer, *got}, sink);
+      }
+      if (now - last_rx > seconds(config_.link_timeout_s))
+        return fail(fmt::format("serial port {}: interface silent for {:.1f} s (no reply to the status request)",
+                                config_.port, duration<double>(now - last_rx).count()));
+      if (now >= next_keepalive) {
+        if (auto sent = send(port, sink, CommandStationStatusRequest{}); !sent) return sent;
+        next_keepalive = now + seconds(config_.keepalive_s);
+      }
+      if (now >= next_sample_) publish(sink, reckoner_.estimate(now_s()));
+    }
+    return {};
+  }
+
+  Result<void> send_startup(serial::SerialPort& port, SampleSink& sink) {
+    std::vector<Request> requests = {InterfaceVersionRequest{}, CommandStationVersionRequest{},
+                                     CommandStationStatusRequest{}};
+    std::set<int> modules;
+    for (const auto& s : config_.layout->sections()) modules.insert(s.input.module);
+    for (int m : modules) {
+      requests.push_back(FeedbackRequest{static_cast<std::uint8_t>(m - 1), false});
+      requests.push_back(FeedbackRequest{static_cast<std::uint8_t>(m - 1), true});
+    }
+    for (const auto& r : requests)
+      if (auto sent = send(port, sink, r); !sent) return sent;
+    return {};
+  }
+
+  Result<void> send(serial::SerialPort& port, SampleSink& sink, const Request& request) {
+    const Prefix prefix = config_.interface == Interface::LiUsb ? Prefix::Reply : Prefix::None;  // FF FE
+    const auto bytes = encode_frame(request_bytes(request), prefix);
+    sink.raw(ByteDirection::ToDevice, bytes.data(), bytes.size());
+    // A few bytes take milliseconds even at 19200 baud; a longer wait means the interface
+    // holds CTS, and waiting on would delay noticing a stop request.
+    return port.write_all(bytes, milliseconds(80));
+  }
+
+  void handle_bytes(std::span<const std::uint8_t> bytes, SampleSink& sink) {
+    const FramingCounters before = decoder_.counters();
+    const auto frames = decoder_.push(bytes);
+    const FramingCounters& after = decoder_.counters();
+    for (auto i = before.bad_checksums; i < after.bad_checksums; ++i) {
+      sink.count_error(fmt::format("{}: frame with a bad XOR byte skipped", config_.port));
+      sink.count_resync();
+    }
+    for (const auto& frame : frames) {
+      std::visit(overloaded{
+                     [&](const Feedback& fb) {
+                       if (feedback_.apply(fb)) reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_), now_s());
+                     },
+                     [&](const InterfaceNotice& n) {
+                       if (n.code != 0x04 && n.code != 0x07) sink.count_error(describe_notice(n.code));
+                     },
+                     [&](const auto&) {},
+                 },
+                 interpret_reply(frame));
+    }
+  }
+
+  void publish(SampleSink& sink, const AlongTrack& along) {
+    for (const auto& p : train_poses(*config_.layout, along, config_.pose_model, config_.parent_frame, now_us(), last_))
+      sink.pose(p);
+    next_sample_ += period_;
+    if (next_sample_ < Clock::now()) next_sample_ = Clock::now() + period_;  // fell behind: no burst
+  }
+
+  void publish_lost_for(SampleSink& sink, std::stop_token stop, Clock::duration how_long) {
+    const auto end = Clock::now() + how_long;
+    while (Clock::now() < end) {
+      if (!sleep_until(stop, std::min(end, next_sample_))) return;
+      if (Clock::now() >= next_sample_) publish(sink, AlongTrack{});
+    }
+  }
+
+  LenzConfig config_;
+  DeadReckoner reckoner_;
+  FeedbackState feedback_;
+  FrameDecoder decoder_;
+  Clock::duration period_;
+  Clock::time_point next_sample_;
+  std::vector<Pose> last_;
+};
+
+}  // namespace
+
+std::unique_ptr<Driver> make_lenz_driver(const LenzConfig& config) { return std::make_unique<LenzDriver>(config); }
+
+}  // namespace covtrack::lenz

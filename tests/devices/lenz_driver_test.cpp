@@ -1,0 +1,208 @@
+// The lenz driver against the emulator, in one process over a real pseudo-terminal:
+// honesty of the reported uncertainty against the emulator's true train position, the
+// LI-USB framing, and a port that disappears mid-run and comes back.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+#include <thread>
+
+#include <Eigen/Cholesky>
+
+#include "capture_sink.hpp"
+#include "covtrack/devices/lenz/layout_config.hpp"
+#include "covtrack/devices/lenz/lenz_driver.hpp"
+#include "covtrack/emulators/lenz/lenz_emulator.hpp"
+#include "covtrack/protocol/clock.hpp"
+
+using namespace covtrack;
+using namespace covtrack::lenz;
+using namespace std::chrono_literals;
+
+namespace {
+
+std::shared_ptr<const TrackLayout> short_layout() {
+  auto layout = load_layout(COVTRACK_SOURCE_DIR "/tests/data/lenz_short_layout.toml");
+  EXPECT_TRUE(layout) << layout.error().message;
+  return std::make_shared<const TrackLayout>(layout ? std::move(*layout) : TrackLayout{});
+}
+
+// Accelerate, cruise, slow down, cruise, stop, wait, restart (one cycle is about 9 s).
+const std::vector<SpeedStep> kProfile{{0.5, 1.5}, {0.15, 1}, {0, 1}, {0.4, 1.5}};
+
+struct Rig {
+  explicit Rig(Interface interface, const std::string& name) {
+    LenzEmulatorOptions options;
+    options.layout = short_layout();
+    options.interface = interface;
+    options.profile = kProfile;
+    options.start_s = 0.1;
+    options.link_path = ::testing::TempDir() + "/covtrack_lenz_" + name + "_" + std::to_string(::getpid());
+    auto created = LenzEmulator::create(options);
+    EXPECT_TRUE(created) << created.error().message;
+    emulator = std::move(*created);
+    emulator_thread = std::jthread([this](std::stop_token stop) { emulator->run(stop, nullptr); });
+
+    config.device = "train";
+    config.port = emulator->device_path();
+    config.interface = interface;
+    config.baud = interface == Interface::LiUsb ? 57600 : 19200;
+    config.layout = options.layout;
+    config.rate_hz = 50;
+    config.keepalive_s = 0.2;
+    config.link_timeout_s = 1.0;
+    config.reconnect_s = 0.1;
+    driver = make_lenz_driver(config);
+    driver_thread = std::jthread([this](std::stop_token stop) { result = driver->run(sink, stop); });
+  }
+  ~Rig() {
+    driver_thread.request_stop();
+    driver_thread.join();
+    emulator_thread.request_stop();
+  }
+  std::vector<PoseSample> poses() {
+    std::lock_guard lock(sink.m);
+    return sink.poses;
+  }
+  std::vector<std::uint8_t> raw() {
+    std::lock_guard lock(sink.m);
+    return sink.raw_bytes;
+  }
+
+  std::unique_ptr<LenzEmulator> emulator;
+  LenzConfig config;
+  std::unique_ptr<Driver> driver;
+  test::CaptureSink sink;
+  Result<void> result;
+  std::jthread emulator_thread, driver_thread;
+};
+
+bool contains(const std::vector<std::uint8_t>& haystack, const std::vector<std::uint8_t>& needle) {
+  return std::search(haystack.begin(), haystack.end(), needle.begin(), needle.end()) != haystack.end();
+}
+
+// The along-track coordinate of a point on the track (nearest, at 1 mm resolution).
+double project(const TrackLayout& layout, const Vec3& p) {
+  double best_s = 0, best_d = 1e9;
+  for (double s = 0; s < layout.length_m(); s += 0.001) {
+    const double d = (layout.pose_at(s).translation() - p).squaredNorm();
+    if (d < best_d) best_d = d, best_s = s;
+  }
+  return best_s;
+}
+
+double loop_distance(const TrackLayout& layout, double a, double b) {
+  const double half = layout.length_m() / 2;
+  return std::abs(layout.wrap(a - b + half) - half);
+}
+
+}  // namespace
+
+TEST(LenzDriver, UncertaintyContainsTheTruthOverSpeedChangesAndAStop) {
+  Rig rig(Interface::Li101f, "honesty");
+  std::this_thread::sleep_for(9s);
+  const auto poses = rig.poses();
+  const TrackLayout& layout = rig.emulator->layout();
+
+  int degraded = 0, inside = 0, pose_inside = 0, vehicles_seen = 0;
+  double width_sum = 0, error_sum = 0;
+  std::set<std::string> sensors;
+  for (const auto& p : poses) {
+    sensors.insert(p.sensor);
+    if (p.sensor != "loco" || p.status != TrackingStatus::Degraded) continue;
+    ++degraded;
+    const double s_true = rig.emulator->true_s_at(p.measurement_time_us);
+    const double s_est = project(layout, p.T_parent_child.translation());
+    const double half_width = kZ99 * std::sqrt(p.covariance(0, 0));
+    const double error = loop_distance(layout, s_true, s_est);
+    inside += error <= half_width + 0.001;  // 1 mm: the projection's resolution
+    width_sum += 2 * half_width;
+    error_sum += error;
+    const Vec6 e = boxminus(layout.pose_at(s_true), p.T_parent_child);
+    pose_inside += e.dot(p.covariance.ldlt().solve(e)) <= 16.812;
+  }
+  vehicles_seen = static_cast<int>(sensors.size());
+  ASSERT_GT(degraded, 300);
+  std::printf("over pty: along-track 99%% interval holds the truth %.4f of %d samples; 6-D 99%% ellipsoid %.4f; "
+              "mean width %.4f m, mean |error| %.4f m\n",
+              double(inside) / degraded, degraded, double(pose_inside) / degraded, width_sum / degraded,
+              error_sum / degraded);
+  EXPECT_GE(double(inside) / degraded, 0.99);
+  EXPECT_GE(double(pose_inside) / degraded, 0.97);
+  EXPECT_LT(width_sum / degraded, layout.length_m() / layout.sections().size());
+  EXPECT_EQ(vehicles_seen, 3);
+  EXPECT_EQ(rig.sink.errors, 0);
+  // The startup queries went out and the replies came back, all on the raw stream.
+  const auto raw = rig.raw();
+  EXPECT_TRUE(contains(raw, {0xF0, 0xF0}));
+  EXPECT_TRUE(contains(raw, {0x21, 0x21, 0x00}));
+  EXPECT_TRUE(contains(raw, {0x63, 0x21, 0x36, 0x00, 0x74}));
+  EXPECT_TRUE(contains(raw, {0x42, 64, 0x80, 0x42 ^ 64 ^ 0x80}));  // module 65, inputs 1-4
+  EXPECT_GT(rig.emulator->broadcasts_sent(), 5u);
+}
+
+TEST(LenzDriver, LiUsbPrefixesBothWays) {
+  Rig rig(Interface::LiUsb, "liusb");
+  std::this_thread::sleep_for(2s);
+  const auto poses = rig.poses();
+  const auto degraded = std::count_if(poses.begin(), poses.end(),
+                                      [](const PoseSample& p) { return p.status == TrackingStatus::Degraded; });
+  EXPECT_GT(degraded, 150);
+  const auto raw = rig.raw();
+  EXPECT_TRUE(contains(raw, {0xFF, 0xFE, 0x21, 0x24, 0x05}));        // request, prefixed
+  EXPECT_TRUE(contains(raw, {0xFF, 0xFE, 0x62, 0x22, 0x00, 0x40}));  // reply
+  EXPECT_TRUE(contains(raw, {0xFF, 0xFD}));                          // a feedback broadcast
+  EXPECT_EQ(rig.sink.errors, 0);
+}
+
+TEST(LenzDriver, PortClosedMidRunGoesLostAndResumesOnReopen) {
+  Rig rig(Interface::Li101f, "unplug");
+  std::this_thread::sleep_for(1500ms);
+  const std::int64_t unplugged_us = now_us();
+  rig.emulator->unplug();
+  std::this_thread::sleep_for(2500ms);
+  const std::int64_t replugged_us = now_us();
+  rig.emulator->replug();
+  std::this_thread::sleep_for(2000ms);
+  const auto poses = rig.poses();
+
+  for (const std::string vehicle : {"loco", "car1", "car2"}) {
+    std::int64_t first_lost_us = -1, first_back_us = -1;
+    bool degraded_before = false;
+    for (const auto& p : poses) {
+      if (p.sensor != vehicle) continue;
+      if (p.measurement_time_us < unplugged_us) degraded_before |= p.status == TrackingStatus::Degraded;
+      if (p.measurement_time_us >= unplugged_us && first_lost_us < 0 && p.status == TrackingStatus::Lost)
+        first_lost_us = p.measurement_time_us;
+      if (p.measurement_time_us >= replugged_us && first_back_us < 0 && p.status == TrackingStatus::Degraded)
+        first_back_us = p.measurement_time_us;
+      // While unplugged (after the first LOST) nothing but LOST.
+      if (first_lost_us >= 0 && p.measurement_time_us > first_lost_us && p.measurement_time_us < replugged_us) {
+        EXPECT_EQ(p.status, TrackingStatus::Lost) << vehicle;
+      }
+    }
+    EXPECT_TRUE(degraded_before) << vehicle;
+    ASSERT_GE(first_lost_us, 0) << vehicle << " never went LOST";
+    EXPECT_LT(first_lost_us - unplugged_us, 2'000'000) << vehicle;
+    ASSERT_GE(first_back_us, 0) << vehicle << " did not resume";
+    std::printf("%s: LOST %.3f s after the unplug, tracking again %.3f s after the replug\n", vehicle.c_str(),
+                (first_lost_us - unplugged_us) * 1e-6, (first_back_us - replugged_us) * 1e-6);
+  }
+  EXPECT_GE(rig.sink.errors, 1);  // the disconnection is reported, the driver kept running
+}
+
+TEST(LenzDriver, MissingPortAtStartIsAClearError) {
+  LenzConfig config;
+  config.device = "train";
+  config.port = "/dev/covtrack-no-such-li101f";
+  config.layout = short_layout();
+  auto driver = make_lenz_driver(config);
+  test::CaptureSink sink;
+  std::stop_source stop;
+  const auto result = driver->run(sink, stop.get_token());
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("/dev/covtrack-no-such-li101f"), std::string::npos) << result.error().message;
+}
