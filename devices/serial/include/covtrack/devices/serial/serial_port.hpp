@@ -1,0 +1,62 @@
+#pragma once
+// A serial port opened by path through libserial, with the failure modes of a device
+// that can vanish at any moment turned into Result values instead of exceptions.
+//
+// Why not call libserial's Read/Close directly: on a device that went away (USB-serial
+// adapter unplugged, emulator closed its pseudo-terminal) Read throws with the text
+// "Success", and Close throws from the destructor, which terminates the process
+// (reference/pitfalls.md). Reading and writing here go through the raw descriptor with
+// poll(), and the teardown is made safe before libserial gets to restore settings.
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "covtrack/protocol/result.hpp"
+
+namespace LibSerial {
+class SerialPort;
+}
+
+namespace covtrack::serial {
+
+struct SerialSettings {
+  std::string path;            // e.g. /dev/ttyUSB0, or a symlink to a pseudo-terminal
+  int baud = 19200;            // one of the standard rates (see is_supported_baud)
+  bool rts_cts = false;        // hardware flow control; 8N1 always
+};
+
+class SerialPort {
+ public:
+  // Opens and configures the port (raw 8N1), discarding anything already buffered.
+  // Fails with a message naming the path when the device is missing or refuses.
+  static Result<std::unique_ptr<SerialPort>> open(const SerialSettings& settings);
+
+  ~SerialPort();
+  SerialPort(const SerialPort&) = delete;
+  SerialPort& operator=(const SerialPort&) = delete;
+
+  // Reads what is available, waiting at most `timeout` for the first byte. Returns 0
+  // bytes on timeout; an error once the device has gone away (hang-up, EOF, EIO).
+  Result<std::size_t> read_some(std::span<std::uint8_t> buffer, std::chrono::milliseconds timeout);
+
+  // Writes all bytes, waiting at most `timeout` in total for the device to take them.
+  Result<void> write_all(std::span<const std::uint8_t> bytes, std::chrono::milliseconds timeout);
+
+  const std::string& path() const { return path_; }
+  bool disconnected() const { return disconnected_; }
+
+ private:
+  SerialPort(std::unique_ptr<LibSerial::SerialPort> port, std::string path);
+  Error disconnect_error(const std::string& what);
+  void close_safely() noexcept;
+
+  std::unique_ptr<LibSerial::SerialPort> port_;
+  std::string path_;
+  int fd_ = -1;
+  bool disconnected_ = false;
+};
+
+}  // namespace covtrack::serial

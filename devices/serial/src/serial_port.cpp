@@ -1,0 +1,181 @@
+#include "covtrack/devices/serial/serial_port.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <libserial/SerialPort.h>
+
+#include <fmt/format.h>
+
+#include "covtrack/devices/serial/baud_rate.hpp"
+
+namespace covtrack::serial {
+namespace {
+
+LibSerial::BaudRate to_libserial(int baud) {
+  switch (baud) {
+    case 1200: return LibSerial::BaudRate::BAUD_1200;
+    case 2400: return LibSerial::BaudRate::BAUD_2400;
+    case 4800: return LibSerial::BaudRate::BAUD_4800;
+    case 9600: return LibSerial::BaudRate::BAUD_9600;
+    case 19200: return LibSerial::BaudRate::BAUD_19200;
+    case 38400: return LibSerial::BaudRate::BAUD_38400;
+    case 57600: return LibSerial::BaudRate::BAUD_57600;
+    case 115200: return LibSerial::BaudRate::BAUD_115200;
+    case 230400: return LibSerial::BaudRate::BAUD_230400;
+    case 460800: return LibSerial::BaudRate::BAUD_460800;
+    case 921600: return LibSerial::BaudRate::BAUD_921600;
+    default: return LibSerial::BaudRate::BAUD_INVALID;
+  }
+}
+
+// Raw bytes, no waiting inside read(): timeouts come from poll(), so a driver's loop
+// keeps control and notices a stop request quickly.
+Result<void> make_raw_nonblocking(int fd) {
+  termios t{};
+  if (::tcgetattr(fd, &t) != 0) return fail(std::strerror(errno));
+  const tcflag_t hardware_flow = t.c_cflag & CRTSCTS;
+  ::cfmakeraw(&t);
+  t.c_cflag |= CLOCAL | CREAD | hardware_flow;
+  t.c_cc[VMIN] = 0;
+  t.c_cc[VTIME] = 0;
+  if (::tcsetattr(fd, TCSANOW, &t) != 0) return fail(std::strerror(errno));
+  const int flags = ::fcntl(fd, F_GETFL);
+  if (flags < 0 || ::fcntl(fd, F_SETFL, flags | O_NONBLOCK) != 0) return fail(std::strerror(errno));
+  ::tcflush(fd, TCIOFLUSH);
+  return {};
+}
+
+}  // namespace
+
+SerialPort::SerialPort(std::unique_ptr<LibSerial::SerialPort> port, std::string path)
+    : port_(std::move(port)), path_(std::move(path)), fd_(port_->GetFileDescriptor()) {}
+
+SerialPort::~SerialPort() { close_safely(); }
+
+Result<std::unique_ptr<SerialPort>> SerialPort::open(const SerialSettings& settings) {
+  const auto where = [&](const std::string& what) { return fmt::format("serial port {}: {}", settings.path, what); };
+  if (!is_supported_baud(settings.baud))
+    return fail(where(fmt::format("unsupported baud rate {}", settings.baud)));
+  if (::access(settings.path.c_str(), F_OK) != 0)
+    return fail(where(fmt::format("no such device ({})", std::strerror(errno))));
+
+  auto lib_port = std::make_unique<LibSerial::SerialPort>();
+  try {
+    lib_port->Open(settings.path);
+  } catch (const std::exception& e) {
+    return fail(where(fmt::format("cannot open: {}", e.what())));
+  }
+  // From here on the wrapper owns the port, so every failure path tears down safely.
+  std::unique_ptr<SerialPort> port(new SerialPort(std::move(lib_port), settings.path));
+  try {
+    port->port_->SetBaudRate(to_libserial(settings.baud));
+    port->port_->SetCharacterSize(LibSerial::CharacterSize::CHAR_SIZE_8);
+    port->port_->SetParity(LibSerial::Parity::PARITY_NONE);
+    port->port_->SetStopBits(LibSerial::StopBits::STOP_BITS_1);
+    port->port_->SetFlowControl(settings.rts_cts ? LibSerial::FlowControl::FLOW_CONTROL_HARDWARE
+                                                 : LibSerial::FlowControl::FLOW_CONTROL_NONE);
+  } catch (const std::exception& e) {
+    port->disconnected_ = true;  // state unknown: take the safe teardown
+    return fail(where(fmt::format("cannot configure 8N1 at {} baud: {}", settings.baud, e.what())));
+  }
+  if (auto raw = make_raw_nonblocking(port->fd_); !raw) {
+    port->disconnected_ = true;
+    return fail(where("cannot set raw mode: " + raw.error().message));
+  }
+  return port;
+}
+
+Error SerialPort::disconnect_error(const std::string& what) {
+  disconnected_ = true;
+  return Error{fmt::format("serial port {}: device disconnected ({})", path_, what)};
+}
+
+Result<std::size_t> SerialPort::read_some(std::span<std::uint8_t> buffer, std::chrono::milliseconds timeout) {
+  if (disconnected_) return std::unexpected(disconnect_error("earlier"));
+  pollfd p{fd_, POLLIN, 0};
+  const int ready = ::poll(&p, 1, static_cast<int>(timeout.count()));
+  if (ready < 0) {
+    if (errno == EINTR) return 0;
+    return std::unexpected(disconnect_error(fmt::format("poll: {}", std::strerror(errno))));
+  }
+  if (ready == 0) return 0;
+  // Read before looking at POLLHUP: the last bytes a device sent may still be buffered.
+  if (p.revents & POLLIN) {
+    const ssize_t n = ::read(fd_, buffer.data(), buffer.size());
+    if (n > 0) return static_cast<std::size_t>(n);
+    if (n == 0) return std::unexpected(disconnect_error("end of file"));
+    if (errno == EAGAIN || errno == EINTR) return 0;
+    return std::unexpected(disconnect_error(std::strerror(errno)));
+  }
+  if (p.revents & POLLHUP) return std::unexpected(disconnect_error("hang-up"));
+  if (p.revents & (POLLERR | POLLNVAL)) return std::unexpected(disconnect_error("error on descriptor"));
+  return 0;
+}
+
+Result<void> SerialPort::write_all(std::span<const std::uint8_t> bytes, std::chrono::milliseconds timeout) {
+  if (disconnected_) return std::unexpected(disconnect_error("earlier"));
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() < 0)
+      return fail(fmt::format("serial port {}: write timed out after {} of {} bytes (flow control holding?)", path_,
+                              done, bytes.size()));
+    pollfd p{fd_, POLLOUT, 0};
+    const int ready = ::poll(&p, 1, static_cast<int>(left.count()));
+    if (ready < 0 && errno != EINTR) return std::unexpected(disconnect_error(std::strerror(errno)));
+    if (ready <= 0) continue;
+    if (p.revents & (POLLHUP | POLLERR | POLLNVAL)) return std::unexpected(disconnect_error("hang-up"));
+    const ssize_t n = ::write(fd_, bytes.data() + done, bytes.size() - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+    } else if (n < 0 && errno != EAGAIN && errno != EINTR) {
+      return std::unexpected(disconnect_error(std::strerror(errno)));
+    }
+  }
+  return {};
+}
+
+// libserial's Close restores the old terminal settings first; on a dead device that
+// fails, the port stays marked open, and its destructor throws again -> std::terminate.
+// So a dead descriptor is swapped for a healthy spare pseudo-terminal slave first.
+void SerialPort::close_safely() noexcept {
+  if (!port_) return;
+  if (!disconnected_) {
+    try {
+      port_->Close();
+      port_.reset();
+      return;
+    } catch (const std::exception&) {
+      // fall through to the dead-device path
+    }
+  }
+  int spare_master = ::posix_openpt(O_RDWR | O_NOCTTY);
+  if (spare_master >= 0 && ::grantpt(spare_master) == 0 && ::unlockpt(spare_master) == 0) {
+    char name[128];
+    if (::ptsname_r(spare_master, name, sizeof name) == 0) {
+      const int spare_slave = ::open(name, O_RDWR | O_NOCTTY);
+      if (spare_slave >= 0) {
+        ::dup2(spare_slave, fd_);
+        ::close(spare_slave);
+      }
+    }
+  }
+  try {
+    port_->Close();
+    port_.reset();
+  } catch (const std::exception&) {
+    // Still refused: leaking the small libserial object is better than terminating.
+    (void)port_.release();
+    ::close(fd_);
+  }
+  if (spare_master >= 0) ::close(spare_master);
+}
+
+}  // namespace covtrack::serial
