@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -67,8 +68,12 @@ Result<void> run_for_samples(test::CaptureSink& sink, const Serial6dofConfig& c,
   auto driver = make_serial6dof_driver(c, run_index);
   std::stop_source stop;
   Result<void> result;
-  std::thread t([&] { result = driver->run(sink, stop.get_token()); });
-  for (int i = 0; i < 1000; ++i) {
+  std::atomic<bool> done = false;
+  std::thread t([&] {
+    result = driver->run(sink, stop.get_token());
+    done = true;
+  });
+  for (int i = 0; i < 1000 && !done; ++i) {
     {
       std::lock_guard l(sink.m);
       std::size_t good = 0;

@@ -7,5 +7,7 @@ namespace covtrack::cli {
 void add_echo_command(CLI::App& app);
 void add_record_command(CLI::App& app);
 void add_replay_command(CLI::App& app);
+void add_emulate_6dof_command(CLI::App& app);
+void add_devices_command(CLI::App& app);
 
 }  // namespace covtrack::cli

@@ -9,6 +9,8 @@ int main(int argc, char** argv) {
   covtrack::cli::add_echo_command(app);
   covtrack::cli::add_record_command(app);
   covtrack::cli::add_replay_command(app);
+  covtrack::cli::add_emulate_6dof_command(app);
+  covtrack::cli::add_devices_command(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }
