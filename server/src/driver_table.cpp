@@ -1,5 +1,6 @@
 #include "driver_table.hpp"
 
+#include "covtrack/devices/hydra/hydra_driver.hpp"
 #include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 #include "covtrack/devices/sim/sim_driver.hpp"
 
@@ -28,6 +29,11 @@ const std::vector<DriverType>& driver_types() {
       serial6dof_row("liberty", "Polhemus LIBERTY or PATRIOT over a serial port", serial6dof::Protocol::Liberty),
       serial6dof_row("flock", "Ascension Flock of Birds (POSITION/QUATERNION) over a serial port",
                      serial6dof::Protocol::Flock),
+      {"hydra", "Razer Hydra: two controllers over HID (hidapi)", {&hydra::hydra_device_spec()},
+       [](TableReader& device, const std::string& name) -> DriverFactory {
+         hydra::HydraConfig config = hydra::read_hydra_config(device, name);
+         return [config](std::uint64_t) { return hydra::make_hydra_driver(config); };
+       }},
   };
   return table;
 }
