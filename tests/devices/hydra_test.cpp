@@ -94,7 +94,9 @@ TEST(HydraDriver, AbsentDeviceIsAClearErrorNotAHang) {
   // With no path given, it searches and says it is not found (no Hydra in the test machine).
   c.hid_path.clear();
   auto search = make_hydra_driver(c)->run(sink, std::stop_source().get_token());
-  if (!search) EXPECT_NE(search.error().message.find("Razer Hydra"), std::string::npos);
+  if (!search) {
+    EXPECT_NE(search.error().message.find("Razer Hydra"), std::string::npos);
+  }
 }
 
 TEST(HydraDriver, DefaultCovarianceIsTheStatedAccuracy) {
