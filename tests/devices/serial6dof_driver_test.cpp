@@ -216,3 +216,33 @@ TEST(Serial6dofDriver, UnpluggedPortGivesLostWithinTwoPeriodsThenRecovers) {
   EXPECT_GE(nees(after, rig).n, 100);
   EXPECT_GE(rig.emulator->resets(), 1u);
 }
+
+TEST(Serial6dofConfig, ErrorsNameTheKeyAndLine) {
+  static toml::table table;  // the reader keeps a reference for the duration of the call
+  table = toml::parse(std::string_view(
+                          "type = \"fastrak\"\nport = \"/dev/x\"\nunits = \"mm\"\n"
+                          "output_items = [\"timestamp\"]\n[[stations]]\nnumber = 2\n[[stations]]\nnumber = 2\n"),
+                      std::string_view("t.toml"));
+  ConfigErrors errors;
+  TableReader r(table, "devices.f", serial6dof_device_spec(Protocol::Fastrak), "t.toml", errors);
+  (void)read_serial6dof_config(r, "f", Protocol::Fastrak);
+  const std::string all = errors.joined();
+  EXPECT_NE(all.find("t.toml:3:9: devices.f.units"), std::string::npos) << all;
+  EXPECT_NE(all.find("need model = \"is900\""), std::string::npos) << all;
+  EXPECT_NE(all.find("station 2 is listed twice"), std::string::npos) << all;
+}
+
+TEST(Serial6dofConfig, DefaultsComeFromTheModel) {
+  static toml::table table;
+  table = toml::parse(std::string_view("type = \"fastrak\"\nport = \"/dev/x\"\nmodel = \"is900\"\n"),
+                      std::string_view("t.toml"));
+  ConfigErrors errors;
+  TableReader r(table, "devices.f", serial6dof_device_spec(Protocol::Fastrak), "t.toml", errors);
+  const auto c = read_serial6dof_config(r, "f", Protocol::Fastrak);
+  EXPECT_TRUE(errors.empty()) << errors.joined();
+  EXPECT_EQ(c.model, Model::Is900);
+  EXPECT_EQ(c.reset_time_s, 20);
+  ASSERT_EQ(c.stations.size(), 1u);
+  EXPECT_EQ(c.stations[0].name, "st1");
+  EXPECT_FALSE(c.stations[0].covariance.has_value());  // the model's accuracy applies
+}
