@@ -58,7 +58,6 @@ Serial6dofConfig driver_config(Model model, const std::vector<int>& stations, co
   c.rate_hz = rate_hz > 0 ? rate_hz : station_rate_hz(model_spec(model), static_cast<int>(stations.size()));
   c.reset_time_s = 0.25;
   c.reply_timeout_s = 1.0;
-  c.watchdog_periods = 2;
   return c;
 }
 
@@ -245,4 +244,34 @@ TEST(Serial6dofConfig, DefaultsComeFromTheModel) {
   ASSERT_EQ(c.stations.size(), 1u);
   EXPECT_EQ(c.stations[0].name, "st1");
   EXPECT_FALSE(c.stations[0].covariance.has_value());  // the model's accuracy applies
+}
+
+TEST(Serial6dofDriver, HungUnitGivesLostThenTheRestartResetsIt) {
+  const double rate_hz = 50;
+  Rig rig = make_rig(Model::Fastrak, {1, 2}, "hung", 0, rate_hz);
+  const auto c = driver_config(Model::Fastrak, {1, 2}, rig.emulator->device_path(), rate_hz);
+  test::CaptureSink sink;
+  auto driver = make_serial6dof_driver(c, 0);
+  Result<void> result;
+  std::thread t([&] { result = driver->run(sink, std::stop_source().get_token()); });
+  while (rig.emulator->records_sent() < 50) std::this_thread::sleep_for(5ms);
+  const std::int64_t hung_us = now_us();
+  rig.emulator->hang();
+  t.join();  // the driver gives up on a silent unit by itself (after ~1 s)
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("no records"), std::string::npos) << result.error().message;
+  std::map<std::string, std::int64_t> first_lost_us;
+  for (const auto& p : sink.poses)
+    if (p.status == TrackingStatus::Lost && !first_lost_us.count(p.sensor)) first_lost_us[p.sensor] = p.measurement_time_us;
+  ASSERT_EQ(first_lost_us.size(), 2u) << "both stations must be reported LOST";
+  for (const auto& [sensor, t_us] : first_lost_us)
+    EXPECT_LT(t_us - hung_us, 2 * 1e6 / rate_hz) << sensor << ": watchdog later than 2 periods";
+
+  // The restart (run 1) resets the unit, which cures it.
+  const auto resets_before = rig.emulator->resets();
+  test::CaptureSink after;
+  EXPECT_TRUE(run_for_samples(after, c, 100, 1));
+  EXPECT_GT(rig.emulator->resets(), resets_before);
+  EXPECT_FALSE(rig.emulator->hung());
+  EXPECT_GE(nees(after, rig).n, 100);
 }

@@ -46,8 +46,9 @@ TableSpec make_device_spec(Protocol p) {
        "the receivers to use: see devices.<name>.stations"},
       {"rate_hz", ValueType::Float, "Hz", "the model's",
        "expected reports per second per station (Fastrak: 120 shared by the stations)", 0.1, 10000},
-      {"watchdog_periods", ValueType::Float, "", "2",
-       "a station is reported LOST after this many report periods without a record", 1, 1000},
+      {"watchdog_periods", ValueType::Float, "", "1.5",
+       "a station is reported LOST after this many report periods without a record (1.5: "
+       "LOST within 2 periods; raise it for a fast unit on a loaded machine)", 1, 1000},
       {"reset_on_start", ValueType::Boolean, "", "true",
        "reset the unit before configuring it (restarts after a failure always reset)"},
       {"reset_time_s", ValueType::Float, "s", "the model's",

@@ -72,6 +72,7 @@ class Emulator::Impl {
         if (unit_->handle(input, reply)) {
           input.clear();
           unit_->power_on();
+          e.hung_ = false;
           reset_done = Clock::now() + duration_cast<Clock::duration>(duration<double>(config_.reset_time_s));
           ++e.resets_;
         }
@@ -80,7 +81,7 @@ class Emulator::Impl {
       if (Clock::now() < next_report) continue;
       next_report += period;
       if (Clock::now() > next_report + 10 * period) next_report = Clock::now() + period;  // stalled
-      if (resetting || !unit_->streaming()) continue;
+      if (resetting || e.hung_ || !unit_->streaming()) continue;
       bool trouble = false;
       if (config_.trouble_every_s > 0 && unit_->trouble_code() >= 0 && Clock::now() >= next_trouble) {
         trouble = true;

@@ -54,6 +54,9 @@ class Emulator {
   void unplug() { want_plugged_ = false; }
   void replug() { want_plugged_ = true; }
   bool plugged() const { return plugged_; }
+  // A hung unit: it stops streaming but still listens; a reset cures it.
+  void hang() { hung_ = true; }
+  bool hung() const { return hung_; }
 
   std::uint64_t records_sent() const { return records_sent_; }
   std::uint64_t resets() const { return resets_; }
@@ -66,7 +69,7 @@ class Emulator {
   std::unique_ptr<Impl> impl_;
   std::string device_path_;
   std::jthread thread_;
-  std::atomic<bool> want_plugged_{true}, plugged_{true}, resetting_{false};
+  std::atomic<bool> want_plugged_{true}, plugged_{true}, resetting_{false}, hung_{false};
   std::atomic<std::uint64_t> records_sent_{0}, resets_{0};
 };
 

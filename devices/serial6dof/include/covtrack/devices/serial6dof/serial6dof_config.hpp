@@ -30,7 +30,7 @@ struct Serial6dofConfig {
   std::vector<LibertyExtra> liberty_extras;
   double flock_position_scale_in = 36;          // Flock
   double rate_hz = 0;                           // per station
-  double watchdog_periods = 2;
+  double watchdog_periods = 1.5;  // + the read poll (a quarter of it): LOST within 2 periods
   bool reset_on_start = true;
   double reset_time_s = 10;
   double reply_timeout_s = 1.0;
