@@ -1,10 +1,22 @@
 #include "driver_table.hpp"
 
+#include "covtrack/devices/hydra/hydra_driver.hpp"
 #include "covtrack/devices/lenz/layout_config.hpp"
 #include "covtrack/devices/lenz/lenz_driver.hpp"
+#include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 #include "covtrack/devices/sim/sim_driver.hpp"
 
 namespace covtrack::server {
+namespace {
+// The three serial 6-DOF protocols share one driver; each has its own row and keys.
+DriverType serial6dof_row(std::string_view type, std::string_view summary, serial6dof::Protocol p) {
+  return {type, summary, {&serial6dof::serial6dof_device_spec(p), &serial6dof::serial6dof_station_spec(p)},
+          [p](TableReader& device, const std::string& name) -> DriverFactory {
+            auto config = serial6dof::read_serial6dof_config(device, name, p);
+            return [config](std::uint64_t run) { return serial6dof::make_serial6dof_driver(config, run); };
+          }};
+}
+}  // namespace
 
 const std::vector<DriverType>& driver_types() {
   static const std::vector<DriverType> table = {
@@ -23,6 +35,16 @@ const std::vector<DriverType>& driver_types() {
        [](TableReader& device, const std::string& name) -> DriverFactory {
          lenz::LenzConfig config = lenz::read_lenz_config(device, name);
          return [config](std::uint64_t) { return lenz::make_lenz_driver(config); };
+       }},
+      serial6dof_row("fastrak", "Polhemus FASTRAK or InterSense IS-900 (Fastrak mode) over a serial port",
+                     serial6dof::Protocol::Fastrak),
+      serial6dof_row("liberty", "Polhemus LIBERTY or PATRIOT over a serial port", serial6dof::Protocol::Liberty),
+      serial6dof_row("flock", "Ascension Flock of Birds (POSITION/QUATERNION) over a serial port",
+                     serial6dof::Protocol::Flock),
+      {"hydra", "Razer Hydra: two controllers over HID (hidapi)", {&hydra::hydra_device_spec()},
+       [](TableReader& device, const std::string& name) -> DriverFactory {
+         hydra::HydraConfig config = hydra::read_hydra_config(device, name);
+         return [config](std::uint64_t) { return hydra::make_hydra_driver(config); };
        }},
   };
   return table;

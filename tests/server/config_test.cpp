@@ -95,9 +95,8 @@ sigma_rad = [0.001, 0.001, 0.001]
 
 TEST(Config, UnknownDriverTypeListsTheKnownOnes) {
   const auto msg = only_error("[devices.x]\ntype = \"vicon\"\n");
-  // Other drivers follow "sim" in the list as they are added.
-  expect_has(msg, "bad.toml:2:8: devices.x.type: unknown driver type 'vicon' (known: sim");
-  expect_has(msg, "lenz");
+  // Every driver row adds a name: check the start of the list and that others follow.
+  expect_has(msg, "bad.toml:2:8: devices.x.type: unknown driver type 'vicon' (known: sim, ");
 }
 
 TEST(Config, BadDeviceNameAndBadSensorName) {

@@ -10,5 +10,7 @@ void add_replay_command(CLI::App& app);
 void add_regions_command(CLI::App& app);
 void add_view_command(CLI::App& app);
 void add_emulate_lenz_command(CLI::App& app);
+void add_emulate_6dof_command(CLI::App& app);
+void add_devices_command(CLI::App& app);
 
 }  // namespace covtrack::cli

@@ -15,6 +15,8 @@ int main(int argc, char** argv) {
   covtrack::cli::add_delegated_command(app, "view", "Draw the objects' error regions over the camera view",
                                        "covtrack-scene");
   covtrack::cli::add_emulate_lenz_command(app);
+  covtrack::cli::add_emulate_6dof_command(app);
+  covtrack::cli::add_devices_command(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

@@ -41,7 +41,9 @@ PseudoTerminal& PseudoTerminal::operator=(PseudoTerminal&& other) noexcept {
 PseudoTerminal::~PseudoTerminal() { unplug(); }
 
 Result<void> PseudoTerminal::open_master() {
-  const int fd = ::posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK);
+  // O_CLOEXEC: a child process (a daemon started by a test after the emulator) must not
+  // inherit the master, or closing it here would never hang up the driver's side.
+  const int fd = ::posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return fail(fmt::format("pseudo-terminal: posix_openpt: {}", std::strerror(errno)));
   char name[128];
   if (::grantpt(fd) != 0 || ::unlockpt(fd) != 0 || ::ptsname_r(fd, name, sizeof name) != 0) {

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -147,6 +148,10 @@ Result<void> SerialPort::write_all(std::span<const std::uint8_t> bytes, std::chr
 // So a dead descriptor is swapped for a healthy spare pseudo-terminal slave first.
 void SerialPort::close_safely() noexcept {
   if (!port_) return;
+  // libserial opens with TIOCEXCL. A pseudo-terminal keeps that flag while its master
+  // stays open, so without clearing it the next open of the same emulator (a driver
+  // restart) fails with EBUSY for anyone but the real root.
+  ::ioctl(fd_, TIOCNXCL);
   if (!disconnected_) {
     try {
       port_->Close();

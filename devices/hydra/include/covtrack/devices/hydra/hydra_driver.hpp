@@ -1,0 +1,33 @@
+#pragma once
+// The Razer Hydra driver (type = "hydra") over hidapi: switches the base into
+// motion-controller mode with its feature report, reads both controllers' poses, and
+// reports them with the configured covariance (default: the manufacturer's 1 mm / 1 degree).
+#include <memory>
+#include <array>
+#include <optional>
+#include <string>
+
+#include "covtrack/devices/config_reader.hpp"
+#include "covtrack/devices/driver.hpp"
+
+namespace covtrack::hydra {
+
+struct HydraConfig {
+  std::string device;
+  std::string parent_frame = "world";
+  std::string hid_path;  // empty: the first Hydra found
+  std::array<std::string, 2> sensors = {"left", "right"};
+  Mat6 covariance = Mat6::Zero();
+  double rate_hz = 250;
+  double watchdog_periods = 4;
+};
+
+// The default covariance: Sixense/Razer state 1 mm position and 1 degree orientation.
+Mat6 hydra_default_covariance();
+
+const TableSpec& hydra_device_spec();
+HydraConfig read_hydra_config(TableReader& device, const std::string& device_name);
+
+std::unique_ptr<Driver> make_hydra_driver(const HydraConfig& config);
+
+}  // namespace covtrack::hydra

@@ -1,0 +1,115 @@
+#include "covtrack/devices/hydra/hydra_driver.hpp"
+
+#include <chrono>
+#include <limits>
+
+#include <fmt/format.h>
+#include <hidapi/hidapi.h>
+
+#include "covtrack/devices/hydra/hydra_report.hpp"
+#include "covtrack/protocol/clock.hpp"
+
+namespace covtrack::hydra {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+// VRPN's experience: a base may need the mode switch repeated; give it this long.
+constexpr double kModeSwitchRetry_s = 2.0;
+constexpr double kNoReports_s = 10.0;
+
+std::string find_hydra_path() {
+  std::string path;
+  hid_device_info* list = hid_enumerate(kVendorId, kProductId);
+  for (auto* d = list; d && path.empty(); d = d->next)
+    if (d->interface_number == kDataInterface && d->path) path = d->path;
+  hid_free_enumeration(list);
+  return path;
+}
+
+class HydraDriver final : public Driver {
+ public:
+  explicit HydraDriver(HydraConfig config) : config_(std::move(config)) {}
+
+  Result<void> run(SampleSink& sink, std::stop_token stop) override {
+    if (hid_init() != 0) return fail("Razer Hydra: hidapi cannot start");
+    const std::string path = config_.hid_path.empty() ? find_hydra_path() : config_.hid_path;
+    if (path.empty())
+      return fail("Razer Hydra: device not found (USB 1532:0300, interface 0): is it plugged in, "
+                  "and may this user open /dev/hidraw* (udev rule)?");
+    hid_device* dev = hid_open_path(path.c_str());
+    if (!dev) return fail(fmt::format("Razer Hydra: cannot open {} (permissions?)", path));
+    auto result = stream(dev, sink, stop);
+    hid_close(dev);
+    return result;
+  }
+
+ private:
+  Result<void> stream(hid_device* dev, SampleSink& sink, std::stop_token stop) {
+    const double period_s = 1.0 / config_.rate_hz;
+    const auto motion = motion_mode_feature_report();
+    auto last_report = Clock::now(), last_switch = Clock::time_point{};
+    std::array<std::uint8_t, 64> buffer{};
+    bool lost = false;
+    while (!stop.stop_requested()) {
+      const double silent_s = std::chrono::duration<double>(Clock::now() - last_report).count();
+      if (silent_s > kModeSwitchRetry_s &&
+          std::chrono::duration<double>(Clock::now() - last_switch).count() > kModeSwitchRetry_s) {
+        hid_send_feature_report(dev, motion.data(), motion.size());
+        last_switch = Clock::now();
+      }
+      if (silent_s > kNoReports_s)
+        return fail(fmt::format("Razer Hydra: no motion reports for {} s", kNoReports_s));
+      const int n = hid_read_timeout(dev, buffer.data(), buffer.size(), 20);
+      if (n < 0) {
+        report_lost(sink);
+        return fail("Razer Hydra: device disconnected (controllers reported LOST)");
+      }
+      if (n == 0) {
+        if (!lost && silent_s > config_.watchdog_periods * period_s) {
+          report_lost(sink);
+          lost = true;
+        }
+        continue;
+      }
+      auto report = parse_hydra_report({buffer.data(), static_cast<std::size_t>(n)});
+      if (!report) {
+        sink.count_error(report.error().message);
+        continue;
+      }
+      last_report = Clock::now();
+      lost = false;
+      const std::int64_t t = now_us();
+      for (int i = 0; i < 2; ++i) {
+        const auto& c = report->controllers[static_cast<std::size_t>(i)];
+        PoseSample s{config_.sensors[i], config_.parent_frame, config_.sensors[i], t};
+        s.T_parent_child = pose_from(hemisphere_.resolve(i, c.position_m), c.orientation);
+        s.covariance = config_.covariance;
+        last_[i] = s.T_parent_child;
+        sink.pose(s);
+      }
+    }
+    return {};
+  }
+
+  void report_lost(SampleSink& sink) {
+    for (int i = 0; i < 2; ++i) {
+      PoseSample s{config_.sensors[i], config_.parent_frame, config_.sensors[i], now_us()};
+      s.status = TrackingStatus::Lost;
+      s.T_parent_child = last_[i];
+      s.covariance = Mat6::Identity() * std::numeric_limits<double>::infinity();
+      sink.pose(s);
+    }
+  }
+
+  HydraConfig config_;
+  HemisphereTracker hemisphere_;
+  std::array<Pose, 2> last_ = {Pose::Identity(), Pose::Identity()};
+};
+
+}  // namespace
+
+std::unique_ptr<Driver> make_hydra_driver(const HydraConfig& config) {
+  return std::make_unique<HydraDriver>(config);
+}
+
+}  // namespace covtrack::hydra

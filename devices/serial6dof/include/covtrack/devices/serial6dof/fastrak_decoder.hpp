@@ -1,0 +1,61 @@
+#pragma once
+// Pure decoder of Polhemus FASTRAK / InterSense IS-900 (Fastrak mode) output: binary pose
+// records ('0', station, status, items..., terminator) and the ASCII status record
+// ('2', station, 'S', ..., CR LF). Bytes in, items out; resyncs on the record header.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "covtrack/devices/serial6dof/tracker_record.hpp"
+
+namespace covtrack::serial6dof {
+
+// Output-list items after position (2) and quaternion (11), in list order
+// (protocols.md B.1). The driver always asks for 2, 11, then these, then 1 (CR LF).
+enum class FastrakExtra { Timestamp = 21, Buttons = 22, Stylus = 16, Joystick = 23 };
+
+struct FastrakFormat {
+  Units units = Units::Centimetres;
+  std::vector<FastrakExtra> extras;
+  bool crlf_terminator = true;  // item 1; false: item 0 (one space), as VRPN asks
+};
+
+// Bytes of one binary record in this format.
+std::size_t fastrak_record_size(const FastrakFormat& format);
+// The output-list command for a station: "O1,2,11,21,1\r".
+std::string fastrak_output_list_command(int station, const FastrakFormat& format);
+
+class FastrakDecoder {
+ public:
+  explicit FastrakDecoder(FastrakFormat format) : format_(std::move(format)) {}
+  void set_format(const FastrakFormat& format) { format_ = format; }
+
+  std::vector<DecodedItem> feed(std::span<const std::uint8_t> bytes);
+
+  std::uint64_t resyncs() const { return resyncs_; }        // times bytes were skipped
+  std::uint64_t bad_records() const { return bad_records_; }  // framed but rejected
+  const std::string& last_problem() const { return last_problem_; }
+
+ private:
+  enum class Step { Item, NeedMore, Skip };
+  Step try_record(std::vector<DecodedItem>& out);
+  Step try_status(std::vector<DecodedItem>& out);
+  void skip_byte();
+
+  FastrakFormat format_;
+  std::vector<std::uint8_t> buffer_;
+  bool skipping_ = false;
+  std::uint64_t resyncs_ = 0, bad_records_ = 0;
+  std::string last_problem_;
+};
+
+// Units reported by a status record ('S' reply): system-flags bit 1 (0 inches, 1 cm);
+// nullopt if the record is malformed.
+std::optional<Units> fastrak_status_units(const DeviceReply& status);
+
+// 1-based station from its ASCII digit ('1'-'9', then 'A'-'C' on the IS-900); 0 if invalid.
+int fastrak_station_from_char(std::uint8_t c);
+char fastrak_station_char(int station);
+
+}  // namespace covtrack::serial6dof

@@ -1,0 +1,42 @@
+#pragma once
+// Pure decoder of Ascension Flock of Birds POSITION/QUATERNION records (protocols.md
+// B.3): 7 phased 14-bit words (x, y, z, q0..q3; q0 scalar), plus the bird's FBB address
+// in group mode. Resyncs on the phasing bit (bit 7 set only in a record's first byte).
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "covtrack/devices/serial6dof/tracker_record.hpp"
+
+namespace covtrack::serial6dof {
+
+struct FlockFormat {
+  double position_scale_in = 36;  // full scale: 36 (standard), 72, or 144 (extended range)
+  bool group_mode = false;        // a 15th byte carries the bird's address
+  int standalone_station = 1;     // the station reported when not in group mode
+};
+
+std::size_t flock_record_size(const FlockFormat& format);
+
+class FlockDecoder {
+ public:
+  explicit FlockDecoder(FlockFormat format) : format_(format) {}
+
+  std::vector<DecodedItem> feed(std::span<const std::uint8_t> bytes);
+
+  std::uint64_t resyncs() const { return resyncs_; }
+  std::uint64_t bad_records() const { return bad_records_; }
+  const std::string& last_problem() const { return last_problem_; }
+
+ private:
+  void skip_byte();
+
+  FlockFormat format_;
+  std::vector<std::uint8_t> buffer_;
+  bool skipping_ = false;
+  std::uint64_t resyncs_ = 0, bad_records_ = 0;
+  std::string last_problem_;
+};
+
+}  // namespace covtrack::serial6dof

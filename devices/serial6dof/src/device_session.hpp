@@ -1,0 +1,45 @@
+#pragma once
+// One protocol's conversation with a unit: the reset and configuration sequence up to
+// continuous output, and the decoding of what it then streams.
+#include <memory>
+#include <span>
+
+#include "covtrack/devices/serial6dof/serial6dof_config.hpp"
+#include "device_link.hpp"
+
+namespace covtrack::serial6dof {
+
+class DeviceSession {
+ public:
+  virtual ~DeviceSession() = default;
+  // Resets the unit if asked, configures it (units confirmed, output lists, stations)
+  // and starts continuous output. An error says what the unit failed to do.
+  virtual Result<void> start(DeviceLink& link, bool reset) = 0;
+  virtual std::vector<DecodedItem> feed(std::span<const std::uint8_t> bytes) = 0;
+  virtual std::uint64_t resyncs() const = 0;
+  virtual std::uint64_t bad_records() const = 0;
+  virtual std::string last_problem() const = 0;
+};
+
+std::unique_ptr<DeviceSession> make_fastrak_session(const Serial6dofConfig& config);
+std::unique_ptr<DeviceSession> make_liberty_session(const Serial6dofConfig& config);
+std::unique_ptr<DeviceSession> make_flock_session(const Serial6dofConfig& config);
+
+// Reads and decodes until `accept` takes a reply, or `timeout_s` passes (nullopt).
+template <typename Accept>
+Result<std::optional<DeviceReply>> await_reply(DeviceLink& link, DeviceSession& session,
+                                                double timeout_s, Accept accept) {
+  using namespace std::chrono;
+  const auto deadline = steady_clock::now() + duration_cast<steady_clock::duration>(duration<double>(timeout_s));
+  std::vector<std::uint8_t> bytes;
+  while (!link.stopped() && steady_clock::now() < deadline) {
+    bytes.clear();
+    auto n = link.read(bytes, milliseconds(20));
+    if (!n) return std::unexpected(n.error());
+    for (auto& item : session.feed(bytes))
+      if (auto* reply = std::get_if<DeviceReply>(&item); reply && accept(*reply)) return *reply;
+  }
+  return std::optional<DeviceReply>{};
+}
+
+}  // namespace covtrack::serial6dof

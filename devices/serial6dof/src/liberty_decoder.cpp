@@ -1,0 +1,92 @@
+#include "covtrack/devices/serial6dof/liberty_decoder.hpp"
+
+#include <fmt/format.h>
+
+#include "float_le.hpp"
+#include "record_check.hpp"
+
+namespace covtrack::serial6dof {
+namespace {
+// Longest frame accepted: who-am-I texts are a few hundred bytes.
+constexpr std::size_t kMaxPayload = 1024;
+}  // namespace
+
+bool is_liberty_preamble(std::uint8_t a, std::uint8_t b) {
+  return (a == 'L' && (b == 'Y' || b == 'U')) || (a == 'P' && (b == 'A' || b == 'L')) ||
+         (a == 'M' && b == 'M');
+}
+
+std::size_t liberty_payload_size(const LibertyFormat& f) {
+  return 12 + 16 + 4 * f.extras.size() + 2;
+}
+
+std::string liberty_output_list_command(int station, const LibertyFormat& f) {
+  std::string cmd = fmt::format("O{},2,7", station);
+  for (auto e : f.extras) cmd += fmt::format(",{}", static_cast<int>(e));
+  return cmd + ",1\r";
+}
+
+void LibertyDecoder::skip_byte() {
+  if (!skipping_) ++resyncs_;
+  skipping_ = true;
+  buffer_.erase(buffer_.begin());
+}
+
+std::vector<DecodedItem> LibertyDecoder::feed(std::span<const std::uint8_t> bytes) {
+  buffer_.insert(buffer_.end(), bytes.begin(), bytes.end());
+  std::vector<DecodedItem> out;
+  while (buffer_.size() >= 2) {
+    if (!is_liberty_preamble(buffer_[0], buffer_[1])) {
+      skip_byte();
+      continue;
+    }
+    if (buffer_.size() < kLibertyHeaderSize) break;
+    const std::uint8_t* h = buffer_.data();
+    const std::size_t size = read_u16_le(h + 6);
+    if (size > kMaxPayload || h[2] == 0) {  // a preamble look-alike inside data
+      skip_byte();
+      continue;
+    }
+    if (buffer_.size() < kLibertyHeaderSize + size) break;
+    const std::uint8_t* p = h + kLibertyHeaderSize;
+    const char command = static_cast<char>(h[3]);
+    if (command == 'C' || command == 'P') {
+      if (size != liberty_payload_size(format_) || p[size - 2] != '\r' || p[size - 1] != '\n') {
+        ++bad_records_;
+        last_problem_ = fmt::format("pose frame of {} bytes, expected {} ending in CR LF", size,
+                                    liberty_payload_size(format_));
+        skip_byte();
+        continue;
+      }
+      TrackerRecord r;
+      r.station = h[2];
+      r.status_code = h[4];
+      r.trouble = !liberty_error_is_ok(h[4]);
+      const double scale = metres_per_unit(format_.units);
+      r.position_m = Vec3(read_float_le(p), read_float_le(p + 4), read_float_le(p + 8)) * scale;
+      r.orientation = Eigen::Quaterniond(read_float_le(p + 12), read_float_le(p + 16),
+                                         read_float_le(p + 20), read_float_le(p + 24));
+      std::size_t at = 28;
+      for (auto e : format_.extras) {
+        if (e == LibertyExtra::Timestamp) r.device_time_s = read_u32_le(p + at) * 1e-3;  // ms
+        if (e == LibertyExtra::Stylus) r.buttons = read_u32_le(p + at);
+        at += 4;
+      }
+      if (const auto problem = record_problem(r)) {
+        ++bad_records_;
+        last_problem_ = *problem;
+        skip_byte();
+        continue;
+      }
+      out.emplace_back(std::move(r));
+    } else {
+      out.emplace_back(DeviceReply{command, h[2], liberty_error_is_ok(h[4]) ? 0 : h[4],
+                                   std::string(p, p + size)});
+    }
+    skipping_ = false;
+    buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(kLibertyHeaderSize + size));
+  }
+  return out;
+}
+
+}  // namespace covtrack::serial6dof

@@ -1,0 +1,277 @@
+// The serial 6-DOF driver against its emulators over real pseudo-terminals: the
+// configuration sequence per protocol, NEES of the reported covariance against the
+// emulator's truth, trouble flags, units, and the port going away and coming back.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <thread>
+
+#include "capture_sink.hpp"
+#include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
+#include "covtrack/emulate6dof/emulator.hpp"
+#include "covtrack/protocol/clock.hpp"
+
+using namespace covtrack;
+using namespace covtrack::serial6dof;
+using namespace std::chrono_literals;
+
+namespace {
+
+std::string link_path(const std::string& name) {
+  return ::testing::TempDir() + "/covtrack_6dof_" + name + "_" + std::to_string(::getpid());
+}
+
+struct Rig {
+  std::unique_ptr<emulate6dof::Emulator> emulator;
+  std::map<std::string, Pose> truth;  // the emulated receivers do not move
+};
+
+Rig make_rig(Model model, const std::vector<int>& stations, const std::string& name,
+             double trouble_every_s = 0, double rate_hz = 0) {
+  emulate6dof::EmulatorConfig ec;
+  ec.model = model;
+  ec.link_path = link_path(name);
+  ec.stations = emulate6dof::default_stations(stations);
+  ec.reset_time_s = 0.2;
+  ec.rate_hz = rate_hz;
+  ec.trouble_every_s = trouble_every_s;
+  ec.seed = 7 + static_cast<std::uint64_t>(model);  // each model its own noise
+  auto e = emulate6dof::Emulator::create(ec);
+  EXPECT_TRUE(e) << e.error().message;
+  Rig rig{std::move(*e), {}};
+  for (const auto& s : ec.stations) rig.truth[s.name] = s.T_source_receiver;
+  rig.emulator->start(nullptr);
+  return rig;
+}
+
+Serial6dofConfig driver_config(Model model, const std::vector<int>& stations, const std::string& port,
+                               double rate_hz = 0) {
+  Serial6dofConfig c;
+  c.device = "dut";
+  c.model = model;
+  c.port = port;
+  for (int s : stations) c.stations.push_back({s, "st" + std::to_string(s), std::nullopt});
+  c.rate_hz = rate_hz > 0 ? rate_hz : station_rate_hz(model_spec(model), static_cast<int>(stations.size()));
+  c.reset_time_s = 0.25;
+  c.reply_timeout_s = 1.0;
+  return c;
+}
+
+// Runs the driver until `wanted` non-LOST poses arrived (or 10 s passed).
+Result<void> run_for_samples(test::CaptureSink& sink, const Serial6dofConfig& c, std::size_t wanted,
+                             std::uint64_t run_index = 0) {
+  auto driver = make_serial6dof_driver(c, run_index);
+  std::stop_source stop;
+  Result<void> result;
+  std::atomic<bool> done = false;
+  std::thread t([&] {
+    result = driver->run(sink, stop.get_token());
+    done = true;
+  });
+  for (int i = 0; i < 1000 && !done; ++i) {
+    {
+      std::lock_guard l(sink.m);
+      std::size_t good = 0;
+      for (const auto& p : sink.poses) good += p.status != TrackingStatus::Lost;
+      if (good >= wanted) break;
+    }
+    std::this_thread::sleep_for(10ms);
+  }
+  stop.request_stop();
+  t.join();
+  return result;
+}
+
+struct NeesSummary {
+  double mean = 0;
+  int n = 0, degraded = 0;
+};
+
+NeesSummary nees(const test::CaptureSink& sink, const Rig& rig) {
+  NeesSummary s;
+  double sum = 0;
+  for (const auto& p : sink.poses) {
+    if (p.status == TrackingStatus::Lost) continue;
+    const Vec6 e = boxminus(rig.truth.at(p.sensor), p.T_parent_child);  // T_true = T_est Exp(e)
+    sum += e.dot(p.covariance.inverse() * e);
+    ++s.n;
+    s.degraded += p.status == TrackingStatus::Degraded;
+  }
+  s.mean = s.n ? sum / s.n : 0;
+  return s;
+}
+
+// 99.9 % two-sided bound on the mean of n chi-square(6) values (variance 12 each).
+double nees_bound(int n) { return 3.29 * std::sqrt(12.0 / n); }
+
+class Serial6dofDriverNees : public ::testing::TestWithParam<Model> {};
+
+}  // namespace
+
+TEST_P(Serial6dofDriverNees, ReportedCovarianceMatchesTheErrorsAgainstTruth) {
+  const Model model = GetParam();
+  const std::vector<int> stations = {1, 2};
+  const std::string name = std::string(model_spec(model).name);
+  const double rate_hz = 200;  // faster than most of these units, to keep the test short
+  Rig rig = make_rig(model, stations, name, /*trouble_every_s=*/0.05, rate_hz);
+  test::CaptureSink sink;
+  auto result = run_for_samples(sink, driver_config(model, stations, rig.emulator->device_path(), rate_hz), 1500);
+  EXPECT_TRUE(result) << result.error().message;
+  const auto s = nees(sink, rig);
+  ASSERT_GE(s.n, 1500) << "errors: " << sink.errors;
+  EXPECT_NEAR(s.mean, 6.0, nees_bound(s.n)) << name << " over " << s.n << " poses";
+  if (model != Model::Flock) {
+    EXPECT_GT(s.degraded, 10) << "trouble flags must give DEGRADED";
+  }
+  for (const auto& p : sink.poses) EXPECT_EQ(p.parent_frame, "world");
+  EXPECT_EQ(sink.errors, 0);
+  std::cout << "[ NEES ] " << name << ": mean " << s.mean << " over " << s.n << " poses ("
+            << s.degraded << " degraded), 99.9% band 6 +- " << nees_bound(s.n) << "\n";
+}
+
+INSTANTIATE_TEST_SUITE_P(AllModels, Serial6dofDriverNees,
+                         ::testing::Values(Model::Fastrak, Model::Is900, Model::Liberty,
+                                           Model::Patriot, Model::Flock),
+                         [](const auto& info) { return std::string(model_spec(info.param).name); });
+
+TEST(Serial6dofDriver, InchesAreConfirmedAndConvertedToo) {
+  for (Model model : {Model::Fastrak, Model::Liberty}) {
+    Rig rig = make_rig(model, {1}, std::string("inches_") + std::string(model_spec(model).name));
+    auto c = driver_config(model, {1}, rig.emulator->device_path());
+    c.units = Units::Inches;
+    test::CaptureSink sink;
+    EXPECT_TRUE(run_for_samples(sink, c, 300));
+    const auto s = nees(sink, rig);
+    ASSERT_GE(s.n, 300);
+    EXPECT_NEAR(s.mean, 6.0, nees_bound(s.n)) << "a units mix-up would be 2.54x off";
+  }
+}
+
+TEST(Serial6dofDriver, FlockScalingMismatchIsAClearError) {
+  Rig rig = make_rig(Model::Flock, {1}, "flock_scale");
+  auto c = driver_config(Model::Flock, {1}, rig.emulator->device_path());
+  c.flock_position_scale_in = 72;  // the emulated bird says 36
+  test::CaptureSink sink;
+  auto result = run_for_samples(sink, c, 1);
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("units not confirmed"), std::string::npos) << result.error().message;
+}
+
+TEST(Serial6dofDriver, MissingPortIsAClearErrorNotAHang) {
+  auto c = driver_config(Model::Fastrak, {1}, "/dev/covtrack-no-such-tracker");
+  test::CaptureSink sink;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto result = make_serial6dof_driver(c, 0)->run(sink, std::stop_source().get_token());
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("/dev/covtrack-no-such-tracker"), std::string::npos);
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 2s);
+}
+
+TEST(Serial6dofDriver, SilentPortIsAClearError) {
+  emulate6dof::EmulatorConfig ec;  // a pseudo-terminal with nothing answering behind it
+  ec.link_path = link_path("silent");
+  ec.stations = emulate6dof::default_stations({1});
+  auto e = emulate6dof::Emulator::create(ec);
+  ASSERT_TRUE(e);  // not started: nobody answers
+  auto c = driver_config(Model::Liberty, {1}, (*e)->device_path());
+  c.reply_timeout_s = 0.2;
+  test::CaptureSink sink;
+  auto result = make_serial6dof_driver(c, 0)->run(sink, std::stop_source().get_token());
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("no answer"), std::string::npos) << result.error().message;
+}
+
+TEST(Serial6dofDriver, UnpluggedPortGivesLostWithinTwoPeriodsThenRecovers) {
+  const double rate_hz = 50;
+  Rig rig = make_rig(Model::Liberty, {1}, "unplug", 0, rate_hz);
+  const auto c = driver_config(Model::Liberty, {1}, rig.emulator->device_path(), rate_hz);
+  test::CaptureSink sink;
+  auto driver = make_serial6dof_driver(c, 0);
+  std::stop_source stop;
+  Result<void> result;
+  std::thread t([&] { result = driver->run(sink, stop.get_token()); });
+  while (rig.emulator->records_sent() < 50) std::this_thread::sleep_for(5ms);
+  const std::int64_t unplugged_us = now_us();
+  rig.emulator->unplug();
+  t.join();  // the driver fails on its own: the port is gone
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("LOST"), std::string::npos) << result.error().message;
+  std::int64_t lost_us = 0;
+  for (const auto& p : sink.poses)
+    if (p.status == TrackingStatus::Lost) { lost_us = p.measurement_time_us; break; }
+  ASSERT_GT(lost_us, 0) << "no LOST report";
+  EXPECT_LT(lost_us - unplugged_us, 2 * 1e6 / rate_hz) << "LOST later than two report periods";
+  EXPECT_TRUE(std::isinf(sink.poses.back().covariance(0, 0)));
+
+  // Back again: the restarted driver (run 1, which resets the unit) streams again.
+  rig.emulator->replug();
+  while (!rig.emulator->plugged()) std::this_thread::sleep_for(5ms);
+  test::CaptureSink after;
+  EXPECT_TRUE(run_for_samples(after, c, 100, 1));
+  EXPECT_GE(nees(after, rig).n, 100);
+  EXPECT_GE(rig.emulator->resets(), 1u);
+}
+
+TEST(Serial6dofConfig, ErrorsNameTheKeyAndLine) {
+  static toml::table table;  // the reader keeps a reference for the duration of the call
+  table = toml::parse(std::string_view(
+                          "type = \"fastrak\"\nport = \"/dev/x\"\nunits = \"mm\"\n"
+                          "output_items = [\"timestamp\"]\n[[stations]]\nnumber = 2\n[[stations]]\nnumber = 2\n"),
+                      std::string_view("t.toml"));
+  ConfigErrors errors;
+  TableReader r(table, "devices.f", serial6dof_device_spec(Protocol::Fastrak), "t.toml", errors);
+  (void)read_serial6dof_config(r, "f", Protocol::Fastrak);
+  const std::string all = errors.joined();
+  EXPECT_NE(all.find("t.toml:3:9: devices.f.units"), std::string::npos) << all;
+  EXPECT_NE(all.find("need model = \"is900\""), std::string::npos) << all;
+  EXPECT_NE(all.find("station 2 is listed twice"), std::string::npos) << all;
+}
+
+TEST(Serial6dofConfig, DefaultsComeFromTheModel) {
+  static toml::table table;
+  table = toml::parse(std::string_view("type = \"fastrak\"\nport = \"/dev/x\"\nmodel = \"is900\"\n"),
+                      std::string_view("t.toml"));
+  ConfigErrors errors;
+  TableReader r(table, "devices.f", serial6dof_device_spec(Protocol::Fastrak), "t.toml", errors);
+  const auto c = read_serial6dof_config(r, "f", Protocol::Fastrak);
+  EXPECT_TRUE(errors.empty()) << errors.joined();
+  EXPECT_EQ(c.model, Model::Is900);
+  EXPECT_EQ(c.reset_time_s, 20);
+  ASSERT_EQ(c.stations.size(), 1u);
+  EXPECT_EQ(c.stations[0].name, "st1");
+  EXPECT_FALSE(c.stations[0].covariance.has_value());  // the model's accuracy applies
+}
+
+TEST(Serial6dofDriver, HungUnitGivesLostThenTheRestartResetsIt) {
+  const double rate_hz = 50;
+  Rig rig = make_rig(Model::Fastrak, {1, 2}, "hung", 0, rate_hz);
+  const auto c = driver_config(Model::Fastrak, {1, 2}, rig.emulator->device_path(), rate_hz);
+  test::CaptureSink sink;
+  auto driver = make_serial6dof_driver(c, 0);
+  Result<void> result;
+  std::thread t([&] { result = driver->run(sink, std::stop_source().get_token()); });
+  while (rig.emulator->records_sent() < 50) std::this_thread::sleep_for(5ms);
+  const std::int64_t hung_us = now_us();
+  rig.emulator->hang();
+  t.join();  // the driver gives up on a silent unit by itself (after ~1 s)
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("no records"), std::string::npos) << result.error().message;
+  std::map<std::string, std::int64_t> first_lost_us;
+  for (const auto& p : sink.poses)
+    if (p.status == TrackingStatus::Lost && !first_lost_us.count(p.sensor)) first_lost_us[p.sensor] = p.measurement_time_us;
+  ASSERT_EQ(first_lost_us.size(), 2u) << "both stations must be reported LOST";
+  for (const auto& [sensor, t_us] : first_lost_us)
+    EXPECT_LT(t_us - hung_us, 2 * 1e6 / rate_hz) << sensor << ": watchdog later than 2 periods";
+
+  // The restart (run 1) resets the unit, which cures it.
+  const auto resets_before = rig.emulator->resets();
+  test::CaptureSink after;
+  EXPECT_TRUE(run_for_samples(after, c, 100, 1));
+  EXPECT_GT(rig.emulator->resets(), resets_before);
+  EXPECT_FALSE(rig.emulator->hung());
+  EXPECT_GE(nees(after, rig).n, 100);
+}

@@ -1,0 +1,166 @@
+#include "covtrack/emulate6dof/emulator.hpp"
+
+#include <chrono>
+#include <numbers>
+#include <random>
+
+#include "covtrack/devices/interruptible_sleep.hpp"
+#include "covtrack/devices/serial/pseudo_terminal.hpp"
+#include "covtrack/devices/serial6dof/covariance_model.hpp"
+#include "covtrack/devices/sim/se3_gaussian.hpp"
+#include "covtrack/protocol/clock.hpp"
+#include "emulated_unit.hpp"
+
+namespace covtrack::emulate6dof {
+
+using namespace std::chrono;
+using namespace serial6dof;
+using Clock = steady_clock;
+
+std::vector<EmulatedStation> default_stations(const std::vector<int>& numbers) {
+  std::vector<EmulatedStation> out;
+  for (std::size_t i = 0; i < numbers.size(); ++i) {
+    const double k = static_cast<double>(i);
+    EmulatedStation s;
+    s.number = numbers[i];
+    s.name = "st" + std::to_string(numbers[i]);
+    // Within 0.5 m of the source, where the specified accuracy holds.
+    s.T_source_receiver = pose_from(
+        Vec3(0.30, -0.15 + 0.1 * k, 0.10),
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.3 + 0.4 * k, Vec3(0.2, 0.5 + 0.1 * k, 1).normalized())));
+    out.push_back(s);
+  }
+  return out;
+}
+
+class Emulator::Impl {
+ public:
+  Impl(const EmulatorConfig& c, serial::PseudoTerminal pty)
+      : config_(c), spec_(model_spec(c.model)), pty_(std::move(pty)), rng_(c.seed) {
+    if (config_.rate_hz <= 0)
+      config_.rate_hz = station_rate_hz(spec_, static_cast<int>(config_.stations.size()));
+    if (config_.reset_time_s < 0) config_.reset_time_s = spec_.reset_time_s;
+    switch (spec_.protocol) {
+      case Protocol::Fastrak: unit_ = make_fastrak_unit(config_); break;
+      case Protocol::Liberty: unit_ = make_liberty_unit(config_); break;
+      case Protocol::Flock: unit_ = make_flock_unit(config_); break;
+    }
+  }
+
+  void run(Emulator& e, std::stop_token stop, const TruthCallback& on_truth) {
+    const auto period = duration_cast<Clock::duration>(duration<double>(1.0 / config_.rate_hz));
+    auto next_report = Clock::now() + period;
+    auto reset_done = Clock::time_point::min();
+    auto next_trouble = Clock::now() + duration_cast<Clock::duration>(duration<double>(config_.trouble_every_s));
+    std::vector<std::uint8_t> input;
+    Bytes reply;
+
+    while (!stop.stop_requested()) {
+      if (!follow_plug(e)) {
+        sleep_for(stop, milliseconds(5));
+        continue;
+      }
+      const auto now = Clock::now();
+      const bool resetting = now < reset_done;
+      e.resetting_ = resetting;
+      std::uint8_t buffer[1024];
+      const auto wait = std::clamp(duration_cast<milliseconds>(next_report - now), milliseconds(0), milliseconds(5));
+      auto n = pty_.read_some(buffer, wait);
+      if (n && *n && !resetting) {  // a resetting unit does not listen
+        input.insert(input.end(), buffer, buffer + *n);
+        reply.clear();
+        if (unit_->handle(input, reply)) {
+          input.clear();
+          unit_->power_on();
+          e.hung_ = false;
+          reset_done = Clock::now() + duration_cast<Clock::duration>(duration<double>(config_.reset_time_s));
+          ++e.resets_;
+        }
+        if (!reply.empty()) (void)pty_.write(reply);
+      }
+      if (Clock::now() < next_report) continue;
+      next_report += period;
+      if (Clock::now() > next_report + 10 * period) next_report = Clock::now() + period;  // stalled
+      if (resetting || e.hung_ || !unit_->streaming()) continue;
+      bool trouble = false;
+      if (config_.trouble_every_s > 0 && unit_->trouble_code() >= 0 && Clock::now() >= next_trouble) {
+        trouble = true;
+        next_trouble += duration_cast<Clock::duration>(duration<double>(config_.trouble_every_s));
+      }
+      report(e, trouble, on_truth);
+    }
+  }
+
+ private:
+  // Applies unplug/replug requests; false while unplugged.
+  bool follow_plug(Emulator& e) {
+    if (e.want_plugged_ != pty_.plugged()) {
+      if (e.want_plugged_) {
+        if (pty_.replug()) unit_->power_on();  // a replugged unit starts from power-up
+      } else {
+        pty_.unplug();
+      }
+      e.plugged_ = pty_.plugged();
+    }
+    return pty_.plugged();
+  }
+
+  void report(Emulator& e, bool trouble, const TruthCallback& on_truth) {
+    const std::int64_t time_us = now_us();
+    std::vector<TrackerRecord> records;
+    for (const auto& st : config_.stations) {
+      TrackerRecord truth;
+      truth.station = st.number;
+      truth.position_m = st.T_source_receiver.translation();
+      truth.orientation = Eigen::Quaterniond(st.T_source_receiver.linear());
+      truth.status_code = trouble ? unit_->trouble_code() : (spec_.protocol == Protocol::Fastrak ? ' ' : 0);
+      truth.trouble = trouble;
+      truth.device_time_s = static_cast<double>(time_us % 1000000000) * 1e-6;
+      // The noise the driver will claim for this record (same model, same inflation).
+      const auto u = record_uncertainty(truth, spec_, std::nullopt, config_.trouble_inflation);
+      const Pose T_est = st.T_source_receiver * se3_exp(-sim::Se3Gaussian(u.covariance).draw(rng_));
+      TrackerRecord r = truth;
+      r.position_m = T_est.translation();
+      r.orientation = Eigen::Quaterniond(T_est.linear());
+      if (r.orientation.w() < 0) r.orientation.coeffs() = -r.orientation.coeffs();
+      records.push_back(r);
+      if (on_truth)
+        on_truth({st.name, config_.parent_frame, st.name, time_us, st.T_source_receiver});
+    }
+    const Bytes bytes = unit_->encode(records);
+    if (!bytes.empty() && pty_.write(bytes)) e.records_sent_ += records.size();
+  }
+
+  EmulatorConfig config_;
+  const ModelSpec& spec_;
+  serial::PseudoTerminal pty_;
+  std::unique_ptr<EmulatedUnit> unit_;
+  std::mt19937_64 rng_;
+};
+
+Result<std::unique_ptr<Emulator>> Emulator::create(const EmulatorConfig& config) {
+  if (config.stations.empty()) return fail("emulator: no stations configured");
+  auto pty = serial::PseudoTerminal::create(config.link_path);
+  if (!pty) return fail("emulator: " + pty.error().message);
+  const std::string path = pty->device_path();
+  auto e = std::unique_ptr<Emulator>(new Emulator(std::make_unique<Impl>(config, std::move(*pty))));
+  e->device_path_ = path;
+  return e;
+}
+
+Emulator::Emulator(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+Emulator::~Emulator() { stop(); }
+
+void Emulator::start(TruthCallback on_truth) {
+  thread_ = std::jthread([this, on_truth = std::move(on_truth)](std::stop_token stop) {
+    impl_->run(*this, stop, on_truth);
+  });
+}
+
+void Emulator::stop() {
+  thread_.request_stop();
+  if (thread_.joinable()) thread_.join();
+}
+
+}  // namespace covtrack::emulate6dof
