@@ -7,5 +7,6 @@ namespace covtrack::cli {
 void add_echo_command(CLI::App& app);
 void add_record_command(CLI::App& app);
 void add_replay_command(CLI::App& app);
+void add_render_tags_command(CLI::App& app);
 
 }  // namespace covtrack::cli

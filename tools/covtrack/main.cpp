@@ -9,6 +9,7 @@ int main(int argc, char** argv) {
   covtrack::cli::add_echo_command(app);
   covtrack::cli::add_record_command(app);
   covtrack::cli::add_replay_command(app);
+  covtrack::cli::add_render_tags_command(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

@@ -11,9 +11,11 @@ double CornerNoiseModel::noise_term(double image_noise, double contrast, double 
   return ratio * ratio * 16.0 / std::max(16.0, edge_length_px / 8.0);
 }
 
-double CornerNoiseModel::sigma_px(double image_noise, double contrast, double edge_length_px) const {
+double CornerNoiseModel::sigma_px(double image_noise, double contrast, double edge_length_px,
+                                  double axis_alignment) const {
   return std::sqrt(floor_px * floor_px +
-                   gain_px * gain_px * noise_term(image_noise, contrast, edge_length_px));
+                   gain_px * gain_px * noise_term(image_noise, contrast, edge_length_px) +
+                   aligned_px * aligned_px * axis_alignment);
 }
 
 double estimate_image_noise(const cv::Mat& gray) {
@@ -74,6 +76,19 @@ double tag_contrast(const cv::Mat& gray, const std::array<cv::Point2d, 4>& c,
     }
   }
   return n ? sum / n : 0;
+}
+
+double edge_axis_alignment(const std::array<cv::Point2d, 4>& c) {
+  constexpr double kWidthRad = 3.0 * M_PI / 180;
+  double sum = 0;
+  for (int e = 0; e < 4; ++e) {
+    const cv::Point2d d = c[(e + 1) % 4] - c[e];
+    // Angle to the nearest pixel axis, in [0, 45 deg].
+    double a = std::fmod(std::abs(std::atan2(d.y, d.x)), M_PI / 2);
+    a = std::min(a, M_PI / 2 - a);
+    sum += std::exp(-(a / kWidthRad) * (a / kWidthRad));
+  }
+  return sum / 4;
 }
 
 double mean_edge_length_px(const std::array<cv::Point2d, 4>& c) {

@@ -34,10 +34,12 @@ cv::Mat render_tags(const CameraModel& camera, const TagFamily& family,
                     const std::vector<RenderedTag>& tags, const RenderLook& look) {
   cv::Mat image(camera.height_px, camera.width_px, CV_32F, cv::Scalar(look.background));
   const int S = std::max(1, look.supersample);
-  const int total = family.cells_across_total();
+  const int margin = std::max(0, look.margin_cells);
+  const int total = family.cells_across_total() + 2 * margin;
   for (const RenderedTag& tag : tags) {
     auto cells = family.cells(tag.id);
     if (!cells) continue;
+    cv::copyMakeBorder(*cells, *cells, margin, margin, margin, margin, cv::BORDER_CONSTANT, 255);
     const double cell_m = tag.size_m / family.cells_across_border();
     const double half_total_m = cell_m * total / 2;
     // The whole printed tag must be in front of the camera.

@@ -27,6 +27,7 @@ struct RenderLook {
   double black = 30, white = 220;  // the tag's two levels
   double blur_sigma_px = 0.8;  // Gaussian optical blur (0: none)
   int supersample = 4;         // sub-samples per pixel and axis
+  int margin_cells = 1;        // white paper around the printed tag, in cells
 };
 
 // The noise-free image (CV_32F grey levels). Tags behind the camera are skipped.
