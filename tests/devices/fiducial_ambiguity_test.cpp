@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <iostream>
 
 #include "covtrack/devices/fiducial/noise_calibration.hpp"
 #include "covtrack/devices/fiducial/tag_pose.hpp"
@@ -20,19 +21,28 @@ TEST(FiducialAmbiguity, CovarianceCoversBothSolutionsOfASmallFaceOnTag) {
   o.decimate = 1;
   auto draws = draw_view(cam, o, v, 100, 77);
   ASSERT_TRUE(draws.has_value()) << draws.error().message;
-  const CornerNoiseModel model{1.3, 0.03, 0.07};
+  const CornerNoiseModel model{1.3, 0.03, 0.07, -0.05, 0.05};
   constexpr double kChi2_6_99 = 16.812;
   int detected = 0, ambiguous = 0, truth_outside = 0, truth_outside_uninflated = 0;
   double max_second_distance = 0;
   for (const ViewDraw& d : *draws) {
     if (!d.detection) continue;
     ++detected;
-    const double sigma = corner_sigma_px(model, d);
-    auto pose = estimate_tag_pose(cam, d.detection->corners_px, v.tag.size_m, sigma);
+    const CornerNoise noise = corner_noise(model, d);
+    const double sigma = noise.sigma_px;
+    auto pose = estimate_tag_pose(cam, d.detection->corners_px, v.tag.size_m, noise);
     ASSERT_TRUE(pose.has_value()) << pose.error().message;
     const Vec6 e = boxminus(d.T_camera_tag_true, pose->best.T_camera_tag);
     truth_outside += e.dot(pose->covariance.ldlt().solve(e)) > kChi2_6_99;
-    const Mat6 plain = pose_covariance(corner_jacobian(cam, pose->best.T_camera_tag, v.tag.size_m), sigma);
+    if (getenv("DBG") && detected < 6) {
+      std::printf("e %s\nsd %s\nsigma %.3f corner err %.3f\n", "", "", sigma, std::sqrt(d.corner_sq_error_px2));
+      std::cout << e.transpose() << "\n" << pose->covariance.diagonal().cwiseSqrt().transpose() << "\n";
+      std::cout << "true t " << d.T_camera_tag_true.translation().transpose() << " est " << pose->best.T_camera_tag.translation().transpose() << "\n";
+    }
+    // The same without inflation: the first-order covariance of the chosen pose alone.
+    auto plain_pose = estimate_tag_pose(cam, d.detection->corners_px, v.tag.size_m, noise, 0.0);
+    ASSERT_TRUE(plain_pose.has_value());
+    const Mat6 plain = plain_pose->covariance;
     truth_outside_uninflated += e.dot(plain.ldlt().solve(e)) > kChi2_6_99;
     if (pose->ambiguous) {
       ++ambiguous;

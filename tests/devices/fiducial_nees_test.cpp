@@ -83,8 +83,9 @@ ViewNees nees_of(const CameraModel& cam, const CalibrationView& v, const std::ve
   double sum = 0, sq = 0;
   for (const ViewDraw& d : draws) {
     if (!d.detection) continue;
-    const double sigma = corner_sigma_px(model, d);
-    auto pose = estimate_tag_pose(cam, d.detection->corners_px, v.tag.size_m, sigma);
+    const CornerNoise noise = corner_noise(model, d);
+    const double sigma = noise.sigma_px;
+    auto pose = estimate_tag_pose(cam, d.detection->corners_px, v.tag.size_m, noise);
     if (!pose) continue;
     const Vec6 e = boxminus(d.T_camera_tag_true, pose->best.T_camera_tag);
     sum += e.dot(pose->covariance.ldlt().solve(e));
@@ -114,8 +115,9 @@ TEST(FiducialNees, CalibratedCornerModelGivesHonestPoseCovariance) {
     calibration.push_back(std::move(*draws));
   }
   const CornerNoiseModel model = fit_corner_noise(cam, calibration_views(), calibration);
-  std::printf("calibrated corner model: gain %.3f px, floor %.4f px, axis-aligned %.4f px\n",
-              model.gain_px, model.floor_px, model.aligned_px);
+  std::printf("calibrated corner model: gain %.3f px, floor %.4f px, axis-aligned %.4f px, "
+              "radial bias %.4f px, radial sigma %.4f px\n",
+              model.gain_px, model.floor_px, model.aligned_px, model.radial_bias_px, model.radial_sigma_px);
 
   double pooled_sum = 0;
   int pooled_n = 0, worst_over = 0, worst_under = 0;

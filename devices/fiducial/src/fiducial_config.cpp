@@ -26,6 +26,10 @@ const TableSpec& fiducial_device_spec() {
         {"corner_floor_px", ValueType::Float, "px", "0.03", "corner noise model: per-camera floor", 0, 100},
         {"corner_aligned_px", ValueType::Float, "px", "0.07", "corner noise model: edges along "
          "pixel axes", 0, 100},
+        {"corner_radial_bias_px", ValueType::Float, "px", "-0.05", "corner noise model: mean "
+         "outward error common to the four corners (removed)", -10, 10},
+        {"corner_radial_sigma_px", ValueType::Float, "px", "0.05", "corner noise model: spread of "
+         "that common error", 0, 100},
         {"ambiguity_chi2", ValueType::Float, "", "16", "inflate the covariance to cover the second "
          "pose when it fits within this many corner variances", 0, 1e6},
         {"rate_hz", ValueType::Float, "Hz", "30", "files: frames per second (0: as fast as "
@@ -83,6 +87,8 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
   c.noise.gain_px = r.number("corner_gain_px", 1.3);
   c.noise.floor_px = r.number("corner_floor_px", 0.03);
   c.noise.aligned_px = r.number("corner_aligned_px", 0.07);
+  c.noise.radial_bias_px = r.number("corner_radial_bias_px", -0.05);
+  c.noise.radial_sigma_px = r.number("corner_radial_sigma_px", 0.05);
   if (c.noise.floor_px <= 0 && c.noise.gain_px <= 0)
     r.error("corner_floor_px", "the corner noise model needs a floor or a gain above zero");
   c.ambiguity_chi2 = r.number("ambiguity_chi2", 16);

@@ -106,7 +106,8 @@ class FiducialDriver final : public Driver {
       const double sigma = config_.noise.sigma_px(raw.image_noise, contrast,
                                                   mean_edge_length_px(det.corners_px),
                                                   edge_axis_alignment(det.corners_px));
-      auto pose = estimate_tag_pose(camera_, det.corners_px, size->second, sigma, config_.ambiguity_chi2);
+      const CornerNoise noise{sigma, config_.noise.radial_bias_px, config_.noise.radial_sigma_px};
+      auto pose = estimate_tag_pose(camera_, det.corners_px, size->second, noise, config_.ambiguity_chi2);
       if (!pose) {
         sink.count_error(fmt::format("tag {}: {}", det.id, pose.error().message));
         continue;

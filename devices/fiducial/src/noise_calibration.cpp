@@ -65,8 +65,9 @@ Result<std::vector<ViewDraw>> draw_view(const CameraModel& camera, const Detecto
   return out;
 }
 
-double corner_sigma_px(const CornerNoiseModel& model, const ViewDraw& d) {
-  return model.sigma_px(d.image_noise, d.contrast, d.edge_length_px, d.axis_alignment);
+CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& d) {
+  return {model.sigma_px(d.image_noise, d.contrast, d.edge_length_px, d.axis_alignment),
+          model.radial_bias_px, model.radial_sigma_px};
 }
 
 double mean_pose_nees(const CameraModel& camera, const CalibrationView& view,
@@ -76,7 +77,7 @@ double mean_pose_nees(const CameraModel& camera, const CalibrationView& view,
   for (const ViewDraw& d : draws) {
     if (!d.detection) continue;
     auto pose = estimate_tag_pose(camera, d.detection->corners_px, view.tag.size_m,
-                                  corner_sigma_px(model, d));
+                                  corner_noise(model, d));
     if (!pose) continue;
     const Vec6 e = boxminus(d.T_camera_tag_true, pose->best.T_camera_tag);
     sum += e.dot(pose->covariance.ldlt().solve(e));
@@ -139,6 +140,15 @@ CornerNoiseModel fit_corner_noise(const CameraModel& camera, const std::vector<C
   const Vec3 c = fit_terms(draws);
   CornerNoiseModel m;
   m.floor_px = std::sqrt(c[0]), m.gain_px = std::sqrt(c[1]), m.aligned_px = std::sqrt(c[2]);
+  double sum = 0, sq = 0;
+  int n = 0;
+  for (const auto& view : draws)
+    for (const ViewDraw& d : view)
+      if (d.detection) sum += d.radial_error_px, sq += d.radial_error_px * d.radial_error_px, ++n;
+  if (n > 1) {
+    m.radial_bias_px = sum / n;
+    m.radial_sigma_px = std::sqrt(std::max(0.0, sq / n - m.radial_bias_px * m.radial_bias_px));
+  }
   for (int round = 0; round < 3; ++round) {
     double sum = 0;
     int total = 0;
@@ -150,7 +160,7 @@ CornerNoiseModel fit_corner_noise(const CameraModel& camera, const std::vector<C
     if (total == 0 || sum <= 0) break;
     // NEES scales as 1 / sigma^2.
     const double f = std::sqrt(sum / total / 6.0);
-    m.floor_px *= f, m.gain_px *= f, m.aligned_px *= f;
+    m.floor_px *= f, m.gain_px *= f, m.aligned_px *= f, m.radial_sigma_px *= f;
   }
   return m;
 }

@@ -66,8 +66,15 @@ Mat6 pose_covariance(const CornerJacobian& J, double sigma) {
   return (cov + cov.transpose()) / 2;
 }
 
+Mat6 pose_covariance(const CornerJacobian& J, const Eigen::Matrix<double, 8, 8>& corner_covariance) {
+  const Mat6 information = J.transpose() * corner_covariance.ldlt().solve(J);
+  Mat6 cov = information.ldlt().solve(Mat6::Identity());
+  return (cov + cov.transpose()) / 2;
+}
+
 Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::Point2d, 4>& c,
-                                  double size_m, double sigma, double ambiguity_chi2) {
+                                  double size_m, const CornerNoise& noise, double ambiguity_chi2) {
+  const double sigma = noise.sigma_px;
   for (const auto& p : c)
     if (!std::isfinite(p.x) || !std::isfinite(p.y))
       return fail("tag corner is not a finite number");
@@ -76,6 +83,18 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
   if (cam.has_distortion()) cv::undistortPoints(image, image, cam.K(), cam.distortion, cv::noArray(), cam.K());
   const double area = std::abs((image[2] - image[0]).cross(image[3] - image[1])) / 2;
   if (!(area > 4)) return fail(fmt::format("tag quad is degenerate (area {:.2f} px^2)", area));
+  // The common radial error: remove its mean, keep its spread for Sigma_c.
+  const cv::Point2d centre = (image[0] + image[1] + image[2] + image[3]) / 4.0;
+  Eigen::Matrix<double, 8, 1> radial;
+  for (int i = 0; i < 4; ++i) {
+    cv::Point2d r = image[i] - centre;
+    r /= std::max(std::hypot(r.x, r.y), 1e-9);
+    radial(2 * i) = r.x, radial(2 * i + 1) = r.y;
+    image[i] -= noise.radial_bias_px * r;
+  }
+  const Eigen::Matrix<double, 8, 8> corner_cov =
+      sigma * sigma * Eigen::Matrix<double, 8, 8>::Identity() +
+      noise.radial_sigma_px * noise.radial_sigma_px * radial * radial.transpose();
 
   const auto object = tag_corners(size_m);
   std::vector<cv::Point3d> obj;
@@ -101,7 +120,7 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
   TagPose out;
   out.best = solutions[0];
   out.corner_sigma_px = sigma;
-  out.covariance = pose_covariance(corner_jacobian(cam, out.best.T_camera_tag, size_m), sigma);
+  out.covariance = pose_covariance(corner_jacobian(cam, out.best.T_camera_tag, size_m), corner_cov);
   out.ambiguity_chi2 = std::numeric_limits<double>::infinity();
   if (solutions.size() > 1) {
     out.second = solutions[1];

@@ -13,6 +13,11 @@
 // exp(-(angle to the nearest axis / 3 deg)^2)). AprilTag samples the edge gradient at
 // whole pixels, so an edge along a pixel row sees the same sub-pixel phase all along and
 // its bias does not average out (measured: 0.1 px at 0 deg against 0.05 px at 2-10 deg).
+// On top of that, all four corners share one error along their radial directions (away
+// from the quad's centre): the detector sees the square a little too small or too large,
+// by radial_bias_px on average (corrected before the pose) with a spread of
+// radial_sigma_px common to the four corners. Independent corner noise would average it
+// away and make the depth over-confident, so it enters Sigma_c as a rank-one term.
 // The floor holds what else noise does not explain (blur, aliasing, the lens).
 // A calibration on rendered views with known truth measures the three coefficients
 // (fit_corner_noise in noise_calibration.hpp; covtrack calibrate-fiducial).
@@ -26,6 +31,8 @@ struct CornerNoiseModel {
   double gain_px = 1.0;
   double floor_px = 0.05;
   double aligned_px = 0.1;
+  double radial_bias_px = 0;   // mean outward error of every corner (negative: inward)
+  double radial_sigma_px = 0;  // spread of that common radial error
 
   // One corner coordinate's standard deviation (px), the same along u and v.
   double sigma_px(double image_noise, double contrast, double edge_length_px,

@@ -8,6 +8,7 @@
 
 #include "covtrack/devices/fiducial/corner_noise.hpp"
 #include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "covtrack/devices/fiducial/tag_pose.hpp"
 #include "covtrack/devices/fiducial/tag_renderer.hpp"
 
 namespace covtrack::fiducial {
@@ -27,7 +28,8 @@ struct ViewDraw {
   Pose T_camera_tag_true = Pose::Identity();
   std::optional<Detection> detection;
   double image_noise = 0, contrast = 0, edge_length_px = 0, axis_alignment = 0;
-  double corner_sq_error_px2 = 0;  // mean over the 8 corner coordinates
+  double corner_sq_error_px2 = 0;  // mean over the 8 coordinates, common radial part removed
+  double radial_error_px = 0;      // the four corners' mean outward error
 };
 
 // Renders, adds noise and detects `draws` times (on `threads` threads, each with its
@@ -36,10 +38,11 @@ Result<std::vector<ViewDraw>> draw_view(const CameraModel& camera, const Detecto
                                         const CalibrationView& view, int draws,
                                         std::uint64_t seed, int threads = 2);
 
-// The model's corner sigma for what this draw's detection saw.
-double corner_sigma_px(const CornerNoiseModel& model, const ViewDraw& draw);
+// The model's corner noise for what this draw's detection saw.
+CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& draw);
 
-// Two stages. (1) Least squares of the per-view mean squared corner error against the
+// Three stages. (0) The radial bias and spread: mean and standard deviation of the
+// per-draw common radial error. (1) Least squares of the per-view mean squared corner error against the
 // model's terms (relative residuals, so small and large errors count alike; a negative
 // coefficient is dropped). (2) The four corners' errors are not independent (neighbours
 // share an edge), so the pose NEES over the calibration views is brought to 6 by one
