@@ -21,14 +21,14 @@ const TableSpec& fiducial_device_spec() {
         {"quad_sigma", ValueType::Float, "px", "0", "blur before the quad search (0.8 speeds up "
          "noisy frames)", 0, 10},
         {"threads", ValueType::Integer, "", "1", "detector threads", 1, 64},
-        {"corner_gain_px", ValueType::Float, "px", "1.3", "corner noise model: noise/contrast gain "
+        {"corner_gain_px", ValueType::Float, "px", "2.08", "corner noise model: noise/contrast gain "
          "(devices/fiducial/README.md)", 0, 100},
-        {"corner_floor_px", ValueType::Float, "px", "0.03", "corner noise model: per-camera floor", 0, 100},
-        {"corner_aligned_px", ValueType::Float, "px", "0.07", "corner noise model: edges along "
+        {"corner_floor_px", ValueType::Float, "px", "0.041", "corner noise model: per-camera floor", 0, 100},
+        {"corner_aligned_px", ValueType::Float, "px", "0.094", "corner noise model: edges along "
          "pixel axes", 0, 100},
-        {"corner_radial_bias_px", ValueType::Float, "px", "-0.05", "corner noise model: mean "
+        {"corner_radial_bias_px", ValueType::Float, "px", "0.036", "corner noise model: mean "
          "outward error common to the four corners (removed)", -10, 10},
-        {"corner_radial_sigma_px", ValueType::Float, "px", "0.05", "corner noise model: spread of "
+        {"corner_radial_sigma_px", ValueType::Float, "px", "0.068", "corner noise model: spread of "
          "that common error", 0, 100},
         {"ambiguity_chi2", ValueType::Float, "", "16", "inflate the covariance to cover the second "
          "pose when it fits within this many corner variances", 0, 1e6},
@@ -84,11 +84,11 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
   c.detector.decimate = r.number("decimate", 2);
   c.detector.quad_sigma = r.number("quad_sigma", 0);
   c.detector.threads = static_cast<int>(r.integer("threads", 1));
-  c.noise.gain_px = r.number("corner_gain_px", 1.3);
-  c.noise.floor_px = r.number("corner_floor_px", 0.03);
-  c.noise.aligned_px = r.number("corner_aligned_px", 0.07);
-  c.noise.radial_bias_px = r.number("corner_radial_bias_px", -0.05);
-  c.noise.radial_sigma_px = r.number("corner_radial_sigma_px", 0.05);
+  c.noise.gain_px = r.number("corner_gain_px", 2.08);
+  c.noise.floor_px = r.number("corner_floor_px", 0.041);
+  c.noise.aligned_px = r.number("corner_aligned_px", 0.094);
+  c.noise.radial_bias_px = r.number("corner_radial_bias_px", 0.036);
+  c.noise.radial_sigma_px = r.number("corner_radial_sigma_px", 0.068);
   if (c.noise.floor_px <= 0 && c.noise.gain_px <= 0)
     r.error("corner_floor_px", "the corner noise model needs a floor or a gain above zero");
   c.ambiguity_chi2 = r.number("ambiguity_chi2", 16);

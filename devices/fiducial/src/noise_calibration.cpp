@@ -33,8 +33,17 @@ ViewDraw one_draw(const CameraModel& camera, TagDetector& detector, const Calibr
   d.edge_length_px = mean_edge_length_px(d.detection->corners_px);
   d.axis_alignment = edge_axis_alignment(d.detection->corners_px);
   const auto truth = projected_corners(camera, tag);
-  for (int k = 0; k < 3; ++k) {
-    const cv::Point2d e = d.detection->corners_px[k] - truth[k];
+  const auto& c = d.detection->corners_px;
+  const cv::Point2d centre = (c[0] + c[1] + c[2] + c[3]) / 4.0;
+  std::array<cv::Point2d, 4> radial, error;
+  for (int k = 0; k < 4; ++k) {
+    radial[k] = c[k] - centre;
+    radial[k] /= std::max(std::hypot(radial[k].x, radial[k].y), 1e-9);
+    error[k] = c[k] - truth[k];
+    d.radial_error_px += error[k].dot(radial[k]) / 4;
+  }
+  for (int k = 0; k < 4; ++k) {
+    const cv::Point2d e = error[k] - d.radial_error_px * radial[k];
     d.corner_sq_error_px2 += e.dot(e) / 8;
   }
   return d;
