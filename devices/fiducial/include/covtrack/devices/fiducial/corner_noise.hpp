@@ -20,7 +20,7 @@
 // away and make the depth over-confident, so it enters Sigma_c as a rank-one term.
 // The floor holds what else noise does not explain (blur, aliasing, the lens).
 // A calibration on rendered views with known truth measures the three coefficients
-// (fit_corner_noise in noise_calibration.hpp; covtrack calibrate-fiducial).
+// (fit_corner_noise in noise_calibration.hpp, run by tests/devices/fiducial_nees_test).
 #include <array>
 
 #include <opencv2/core.hpp>

@@ -1,6 +1,6 @@
 #pragma once
 // Measuring the corner noise model on rendered frames with known truth: the calibration
-// procedure of the fiducial tracker (covtrack calibrate-fiducial, and the honesty test,
+// procedure of the fiducial tracker (run by the honesty test fiducial_nees_test,
 // which calibrates on one set of views and validates on another).
 #include <cstdint>
 #include <optional>
