@@ -1,5 +1,6 @@
 #include "driver_table.hpp"
 
+#include "covtrack/devices/fiducial/fiducial_driver.hpp"
 #include "covtrack/devices/hydra/hydra_driver.hpp"
 #include "covtrack/devices/lenz/layout_config.hpp"
 #include "covtrack/devices/lenz/lenz_driver.hpp"
@@ -45,6 +46,13 @@ const std::vector<DriverType>& driver_types() {
        [](TableReader& device, const std::string& name) -> DriverFactory {
          hydra::HydraConfig config = hydra::read_hydra_config(device, name);
          return [config](std::uint64_t) { return hydra::make_hydra_driver(config); };
+       }},
+      {"fiducial", "AprilTag fiducial tracker: tag poses from a camera, video or image sequence, "
+       "covariance from a calibrated corner noise model",
+       {&fiducial::fiducial_device_spec(), &fiducial::fiducial_tag_spec()},
+       [](TableReader& device, const std::string& name) -> DriverFactory {
+         fiducial::FiducialConfig config = fiducial::read_fiducial_config(device, name);
+         return [config](std::uint64_t run) { return fiducial::make_fiducial_driver(config, run); };
        }},
   };
   return table;

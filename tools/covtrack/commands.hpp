@@ -12,5 +12,6 @@ void add_view_command(CLI::App& app);
 void add_emulate_lenz_command(CLI::App& app);
 void add_emulate_6dof_command(CLI::App& app);
 void add_devices_command(CLI::App& app);
+void add_render_tags_command(CLI::App& app);
 
 }  // namespace covtrack::cli

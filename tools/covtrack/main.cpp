@@ -11,9 +11,11 @@ int main(int argc, char** argv) {
   covtrack::cli::add_record_command(app);
   covtrack::cli::add_replay_command(app);
   covtrack::cli::add_delegated_command(app, "regions", "Screen error regions of a scene's objects (offline)",
-                                       "covtrack-scene");
+                                       "covtrack-vision");
   covtrack::cli::add_delegated_command(app, "view", "Draw the objects' error regions over the camera view",
-                                       "covtrack-scene");
+                                       "covtrack-vision");
+  covtrack::cli::add_delegated_command(app, "render-tags", "Render AprilTags at known poses (images or video + truth)",
+                                       "covtrack-vision");
   covtrack::cli::add_emulate_lenz_command(app);
   covtrack::cli::add_emulate_6dof_command(app);
   covtrack::cli::add_devices_command(app);

@@ -1,0 +1,33 @@
+#pragma once
+// Options of the AprilTag fiducial tracker (type = "fiducial"), read from its
+// [devices.<name>] table and its [[devices.<name>.tags]] tag map.
+#include <map>
+#include <string>
+
+#include "covtrack/devices/config_reader.hpp"
+#include "covtrack/devices/fiducial/corner_noise.hpp"
+#include "covtrack/devices/fiducial/tag_detector.hpp"
+
+namespace covtrack::fiducial {
+
+struct FiducialConfig {
+  std::string device;
+  std::string parent_frame = "camera";  // poses are T_camera_tag
+  std::string source;          // a V4L2 camera index ("0"), a video file or an image pattern
+  std::string calibration;     // OpenCV calibration file
+  DetectorOptions detector;
+  CornerNoiseModel noise;
+  double ambiguity_chi2 = 16;
+  double rate_hz = 30;         // files: replay pace (0: as fast as possible); cameras: ignored
+  bool loop = true;            // files: start over at the end
+  bool publish_raw = true;
+  std::map<int, double> tag_size_m;  // the tag map: id -> edge of the detected square
+};
+
+const TableSpec& fiducial_device_spec();
+const TableSpec& fiducial_tag_spec();
+
+// Relative paths are taken from the config file's folder. Problems go to the reader.
+FiducialConfig read_fiducial_config(TableReader& device, const std::string& device_name);
+
+}  // namespace covtrack::fiducial

@@ -1,0 +1,14 @@
+#pragma once
+// The AprilTag fiducial tracker: frames from a camera, a video or an image sequence;
+// per mapped tag a pose T_camera_tag (sensor "tag<id>") with its covariance; the raw
+// detections on covtrack/raw/<device>.
+#include <memory>
+
+#include "covtrack/devices/driver.hpp"
+#include "covtrack/devices/fiducial/fiducial_config.hpp"
+
+namespace covtrack::fiducial {
+
+std::unique_ptr<Driver> make_fiducial_driver(const FiducialConfig& config, std::uint64_t run_index);
+
+}  // namespace covtrack::fiducial

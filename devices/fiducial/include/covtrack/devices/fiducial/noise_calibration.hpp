@@ -1,0 +1,59 @@
+#pragma once
+// Measuring the corner noise model on rendered frames with known truth: the calibration
+// procedure of the fiducial tracker (run by the honesty test fiducial_nees_test,
+// which calibrates on one set of views and validates on another).
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "covtrack/devices/fiducial/corner_noise.hpp"
+#include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "covtrack/devices/fiducial/tag_pose.hpp"
+#include "covtrack/devices/fiducial/tag_renderer.hpp"
+
+namespace covtrack::fiducial {
+
+// One view: a tag, how it looks, how noisy the sensor is.
+struct CalibrationView {
+  RenderedTag tag;
+  RenderLook look;
+  double noise_sigma = 3;  // grey levels
+  // Each draw moves the tag by up to this much (m, rad per axis), so that the
+  // detector's sub-pixel bias varies between draws as it does for a moving camera.
+  double jitter_m = 0.003, jitter_rad = 0.01;
+};
+
+// One draw of a view: the truth, and what the detector and the noise model saw.
+struct ViewDraw {
+  Pose T_camera_tag_true = Pose::Identity();
+  std::optional<Detection> detection;
+  double image_noise = 0, contrast = 0, edge_length_px = 0, axis_alignment = 0;
+  double corner_sq_error_px2 = 0;  // mean over the 8 coordinates, common radial part removed
+  double radial_error_px = 0;      // the four corners' mean outward error
+};
+
+// Renders, adds noise and detects `draws` times (on `threads` threads, each with its
+// own detector); deterministic for a given seed.
+Result<std::vector<ViewDraw>> draw_view(const CameraModel& camera, const DetectorOptions& detector,
+                                        const CalibrationView& view, int draws,
+                                        std::uint64_t seed, int threads = 2);
+
+// The model's corner noise for what this draw's detection saw.
+CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& draw);
+
+// Three stages. (0) The radial bias and spread: mean and standard deviation of the
+// per-draw common radial error. (1) Least squares of the per-view mean squared corner error against the
+// model's terms (relative residuals, so small and large errors count alike; a negative
+// coefficient is dropped). (2) The four corners' errors are not independent (neighbours
+// share an edge), so the pose NEES over the calibration views is brought to 6 by one
+// common factor on all coefficients.
+CornerNoiseModel fit_corner_noise(const CameraModel& camera,
+                                  const std::vector<CalibrationView>& views,
+                                  const std::vector<std::vector<ViewDraw>>& draws);
+
+// Mean pose NEES of the detected draws of one view under `model`; `count` gets how many.
+double mean_pose_nees(const CameraModel& camera, const CalibrationView& view,
+                      const std::vector<ViewDraw>& draws, const CornerNoiseModel& model,
+                      int* count = nullptr);
+
+}  // namespace covtrack::fiducial

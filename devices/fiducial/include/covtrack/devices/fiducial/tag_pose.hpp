@@ -1,0 +1,62 @@
+#pragma once
+// A tag's pose from its four corners, with a first-order covariance (BODY convention,
+// protocol/README.md: T_true = T_est * Exp(xi), xi = [translation, rotation]).
+//
+// A square seen in perspective has two poses that fit (the tilt ambiguity); both come
+// from OpenCV's IPPE_SQUARE and are polished by Levenberg-Marquardt. The covariance is
+// (J^T Sigma_c^-1 J)^-1, J the Jacobian of the four projected corners w.r.t. xi, and
+// Sigma_c = sigma^2 I + radial_sigma^2 r r^T (r: the corners' unit radial directions
+// stacked; see corner_noise.hpp). Corners are first moved by -radial_bias along r. When the second pose fits nearly as well (its extra
+// squared reprojection error below `ambiguity_chi2` corner variances) the covariance
+// gets the outer product of the step to it, so that it covers both.
+#include <array>
+#include <optional>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "covtrack/devices/fiducial/camera_model.hpp"
+#include "covtrack/protocol/result.hpp"
+#include "covtrack/protocol/se3.hpp"
+
+namespace covtrack::fiducial {
+
+using CornerJacobian = Eigen::Matrix<double, 8, 6>;
+
+struct PoseSolution {
+  Pose T_camera_tag = Pose::Identity();
+  double sse_px2 = 0;  // sum of squared corner reprojection errors
+};
+
+struct TagPose {
+  PoseSolution best;
+  std::optional<PoseSolution> second;
+  Mat6 covariance = Mat6::Zero();  // BODY convention, inflation included
+  double corner_sigma_px = 0;
+  double ambiguity_chi2 = 0;       // (sse second - sse best) / sigma^2; inf without second
+  bool ambiguous = false;          // the covariance was inflated to cover the second pose
+};
+
+// d(corner pixels)/d(xi) at T_camera_tag, rows u0 v0 u1 v1 ..., pinhole projection.
+CornerJacobian corner_jacobian(const CameraModel& camera, const Pose& T_camera_tag, double size_m);
+
+// What the noise model says about one tag's corners.
+struct CornerNoise {
+  double sigma_px = 0.1;       // independent, per coordinate
+  double radial_bias_px = 0;   // common outward error, removed before the pose
+  double radial_sigma_px = 0;  // common outward error's spread
+};
+
+// sigma^2 (J^T J)^-1: the pose covariance from independent corner noise of sigma px.
+Mat6 pose_covariance(const CornerJacobian& J, double corner_sigma_px);
+// (J^T Sigma_c^-1 J)^-1 for a full 8x8 corner covariance.
+Mat6 pose_covariance(const CornerJacobian& J, const Eigen::Matrix<double, 8, 8>& corner_covariance);
+
+// Corner pixels are undistorted with the camera's distortion first; the noise model is
+// applied to the undistorted corners. Fails on degenerate input (non-finite corners,
+// a collapsed quad) or when no pose is found.
+Result<TagPose> estimate_tag_pose(const CameraModel& camera,
+                                  const std::array<cv::Point2d, 4>& corners_px, double size_m,
+                                  const CornerNoise& noise, double ambiguity_chi2 = 16.0);
+
+}  // namespace covtrack::fiducial

@@ -1,0 +1,100 @@
+#include "covtrack/devices/fiducial/corner_noise.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace covtrack::fiducial {
+
+double CornerNoiseModel::noise_term(double image_noise, double contrast, double edge_length_px) {
+  const double ratio = image_noise / std::max(contrast, 1.0);
+  return ratio * ratio * 16.0 / std::max(16.0, edge_length_px / 8.0);
+}
+
+double CornerNoiseModel::sigma_px(double image_noise, double contrast, double edge_length_px,
+                                  double axis_alignment) const {
+  return std::sqrt(floor_px * floor_px +
+                   gain_px * gain_px * noise_term(image_noise, contrast, edge_length_px) +
+                   aligned_px * aligned_px * axis_alignment);
+}
+
+double estimate_image_noise(const cv::Mat& gray) {
+  CV_Assert(gray.type() == CV_8UC1);
+  // The filter [1 -2 1; -2 4 -2; 1 -2 1] cancels any locally planar image and leaves
+  // 6 sigma of white noise in its standard deviation; a median needs no edge mask.
+  constexpr int kStep = 3;
+  std::vector<int> responses;
+  responses.reserve(static_cast<std::size_t>(gray.rows / kStep + 1) * (gray.cols / kStep + 1));
+  for (int r = 1; r + 1 < gray.rows; r += kStep) {
+    const std::uint8_t* a = gray.ptr<std::uint8_t>(r - 1);
+    const std::uint8_t* b = gray.ptr<std::uint8_t>(r);
+    const std::uint8_t* c = gray.ptr<std::uint8_t>(r + 1);
+    for (int x = 1; x + 1 < gray.cols; x += kStep) {
+      const int v = a[x - 1] - 2 * a[x] + a[x + 1] - 2 * (b[x - 1] - 2 * b[x] + b[x + 1]) +
+                    c[x - 1] - 2 * c[x] + c[x + 1];
+      responses.push_back(std::abs(v));
+    }
+  }
+  if (responses.empty()) return 0;
+  auto mid = responses.begin() + static_cast<std::ptrdiff_t>(responses.size() / 2);
+  std::nth_element(responses.begin(), mid, responses.end());
+  // For Gaussian noise the median of |N(0, 36 sigma^2)| is 0.6745 * 6 sigma.
+  return *mid / (0.6745 * 6.0);
+}
+
+namespace {
+double sample(const cv::Mat& gray, cv::Point2d p) {
+  const int x = static_cast<int>(std::floor(p.x)), y = static_cast<int>(std::floor(p.y));
+  if (x < 0 || y < 0 || x + 1 >= gray.cols || y + 1 >= gray.rows) return std::nan("");
+  const double fx = p.x - x, fy = p.y - y;
+  const auto at = [&](int yy, int xx) { return static_cast<double>(gray.at<std::uint8_t>(yy, xx)); };
+  return (1 - fy) * ((1 - fx) * at(y, x) + fx * at(y, x + 1)) +
+         fy * ((1 - fx) * at(y + 1, x) + fx * at(y + 1, x + 1));
+}
+}  // namespace
+
+double tag_contrast(const cv::Mat& gray, const std::array<cv::Point2d, 4>& c,
+                    int cells_across_border) {
+  cv::Point2d centre(0, 0);
+  for (const auto& p : c) centre += p / 4.0;
+  double sum = 0;
+  int n = 0;
+  for (int e = 0; e < 4; ++e) {
+    const cv::Point2d a = c[e], b = c[(e + 1) % 4];
+    for (double f : {0.25, 0.5, 0.75}) {
+      const cv::Point2d on = a + f * (b - a);
+      // Half a cell towards the centre and away from it (a cell is the edge / cells).
+      const cv::Point2d towards_centre = centre - on;
+      const double to_centre = std::hypot(towards_centre.x, towards_centre.y);
+      if (to_centre <= 0) continue;
+      const double half_cell = 0.5 * std::hypot(b.x - a.x, b.y - a.y) / cells_across_border;
+      const cv::Point2d step = towards_centre * (half_cell / to_centre);
+      const double in = sample(gray, on + step), out = sample(gray, on - step);
+      if (std::isnan(in) || std::isnan(out)) continue;
+      sum += std::abs(out - in);
+      ++n;
+    }
+  }
+  return n ? sum / n : 0;
+}
+
+double edge_axis_alignment(const std::array<cv::Point2d, 4>& c) {
+  constexpr double kWidthRad = 3.0 * M_PI / 180;
+  double sum = 0;
+  for (int e = 0; e < 4; ++e) {
+    const cv::Point2d d = c[(e + 1) % 4] - c[e];
+    // Angle to the nearest pixel axis, in [0, 45 deg].
+    double a = std::fmod(std::abs(std::atan2(d.y, d.x)), M_PI / 2);
+    a = std::min(a, M_PI / 2 - a);
+    sum += std::exp(-(a / kWidthRad) * (a / kWidthRad));
+  }
+  return sum / 4;
+}
+
+double mean_edge_length_px(const std::array<cv::Point2d, 4>& c) {
+  double sum = 0;
+  for (int e = 0; e < 4; ++e) sum += std::hypot(c[(e + 1) % 4].x - c[e].x, c[(e + 1) % 4].y - c[e].y);
+  return sum / 4;
+}
+
+}  // namespace covtrack::fiducial

@@ -1,0 +1,109 @@
+#include "covtrack/devices/fiducial/fiducial_config.hpp"
+
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "covtrack/devices/device_keys.hpp"
+
+namespace covtrack::fiducial {
+
+const TableSpec& fiducial_device_spec() {
+  static const TableSpec spec = [] {
+    TableSpec s{"devices.<name> (type = \"fiducial\")", "fiducial driver", device_common_keys()};
+    const std::vector<KeySpec> own = {
+        {"source", ValueType::String, "", "", "camera: V4L2 index (\"0\"); or a video file; or an "
+         "image sequence pattern (\"frames/frame_%04d.png\"); relative to this file"},
+        {"calibration", ValueType::String, "", "", "OpenCV calibration file (camera_matrix, "
+         "distortion_coefficients, image_width, image_height); relative to this file"},
+        {"family", ValueType::String, "", "\"tag36h11\"", "AprilTag family"},
+        {"decimate", ValueType::Float, "", "2", "quad search on an image this much smaller", 1, 8},
+        {"quad_sigma", ValueType::Float, "px", "0", "blur before the quad search (0.8 speeds up "
+         "noisy frames)", 0, 10},
+        {"threads", ValueType::Integer, "", "1", "detector threads", 1, 64},
+        {"corner_gain_px", ValueType::Float, "px", "2.08", "corner noise model: noise/contrast gain "
+         "(devices/fiducial/README.md)", 0, 100},
+        {"corner_floor_px", ValueType::Float, "px", "0.041", "corner noise model: per-camera floor", 0, 100},
+        {"corner_aligned_px", ValueType::Float, "px", "0.094", "corner noise model: edges along "
+         "pixel axes", 0, 100},
+        {"corner_radial_bias_px", ValueType::Float, "px", "0.036", "corner noise model: mean "
+         "outward error common to the four corners (removed)", -10, 10},
+        {"corner_radial_sigma_px", ValueType::Float, "px", "0.068", "corner noise model: spread of "
+         "that common error", 0, 100},
+        {"ambiguity_chi2", ValueType::Float, "", "16", "inflate the covariance to cover the second "
+         "pose when it fits within this many corner variances", 0, 1e6},
+        {"rate_hz", ValueType::Float, "Hz", "30", "files: frames per second (0: as fast as "
+         "possible); cameras run at their own rate", 0, 10000},
+        {"loop", ValueType::Boolean, "", "true", "files: start over at the end"},
+        {"publish_raw", ValueType::Boolean, "", "true", "publish detections on covtrack/raw/<name> "
+         "(format: devices/fiducial/README.md)"},
+        {"tags", ValueType::TableArray, "", "", "the tag map: [[devices.<name>.tags]]; tags not "
+         "listed are ignored"},
+    };
+    s.keys.insert(s.keys.end(), own.begin(), own.end());
+    return s;
+  }();
+  return spec;
+}
+
+const TableSpec& fiducial_tag_spec() {
+  static const TableSpec spec{
+      "devices.<name>.tags (type = \"fiducial\")",
+      "fiducial driver",
+      {
+          {"id", ValueType::Integer, "", "", "tag id in the family; its sensor is \"tag<id>\"", 0, 1e6},
+          {"size_m", ValueType::Float, "m", "", "edge of the detected square (black border's outer "
+           "edge)", 1e-4, 100},
+      }};
+  return spec;
+}
+
+namespace {
+std::string relative_to_config(const std::string& path, const std::string& config_file) {
+  if (path.empty() || std::filesystem::path(path).is_absolute()) return path;
+  return (std::filesystem::path(config_file).parent_path() / path).string();
+}
+bool is_camera_index(const std::string& s) {
+  return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos;
+}
+}  // namespace
+
+FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_name) {
+  FiducialConfig c;
+  c.device = device_name;
+  c.parent_frame = r.string("parent_frame", "world");
+  c.source = r.string("source");
+  if (!is_camera_index(c.source)) c.source = relative_to_config(c.source, r.file());
+  c.calibration = relative_to_config(r.string("calibration"), r.file());
+  c.detector.family = r.string("family", "tag36h11");
+  bool known = false;
+  for (const auto& f : tag_family_names()) known |= f == c.detector.family;
+  if (!known)
+    r.error("family", fmt::format("unknown AprilTag family '{}' (known: {})", c.detector.family,
+                                  fmt::join(tag_family_names(), ", ")));
+  c.detector.decimate = r.number("decimate", 2);
+  c.detector.quad_sigma = r.number("quad_sigma", 0);
+  c.detector.threads = static_cast<int>(r.integer("threads", 1));
+  c.noise.gain_px = r.number("corner_gain_px", 2.08);
+  c.noise.floor_px = r.number("corner_floor_px", 0.041);
+  c.noise.aligned_px = r.number("corner_aligned_px", 0.094);
+  c.noise.radial_bias_px = r.number("corner_radial_bias_px", 0.036);
+  c.noise.radial_sigma_px = r.number("corner_radial_sigma_px", 0.068);
+  if (c.noise.floor_px <= 0 && c.noise.gain_px <= 0)
+    r.error("corner_floor_px", "the corner noise model needs a floor or a gain above zero");
+  c.ambiguity_chi2 = r.number("ambiguity_chi2", 16);
+  c.rate_hz = r.number("rate_hz", 30);
+  c.loop = r.boolean("loop", true);
+  c.publish_raw = r.boolean("publish_raw", true);
+  for (const toml::table* t : r.tables("tags")) {
+    TableReader tr(*t, r.path("tags"), fiducial_tag_spec(), r.file(), r.errors());
+    const int id = static_cast<int>(tr.integer("id", 0));
+    const double size = tr.number("size_m", 0.1);
+    if (c.tag_size_m.count(id)) tr.error("id", fmt::format("tag {} is listed twice", id));
+    c.tag_size_m[id] = size;
+  }
+  if (c.tag_size_m.empty()) r.error("tags", "needs at least one [[tags]] entry (id, size_m)");
+  return c;
+}
+
+}  // namespace covtrack::fiducial

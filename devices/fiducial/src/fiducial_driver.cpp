@@ -1,0 +1,158 @@
+#include "covtrack/devices/fiducial/fiducial_driver.hpp"
+
+#include <chrono>
+#include <limits>
+#include <set>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "covtrack/devices/fiducial/raw_detection.hpp"
+#include "covtrack/devices/fiducial/tag_pose.hpp"
+#include "covtrack/devices/interruptible_sleep.hpp"
+#include "covtrack/protocol/clock.hpp"
+
+namespace covtrack::fiducial {
+namespace {
+
+bool is_camera_index(const std::string& s) {
+  return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos;
+}
+
+class FiducialDriver final : public Driver {
+ public:
+  explicit FiducialDriver(const FiducialConfig& config) : config_(config) {}
+
+  Result<void> run(SampleSink& sink, std::stop_token stop) override {
+    try {
+      return run_checked(sink, stop);
+    } catch (const std::exception& e) {  // OpenCV throws cv::Exception on odd input
+      return fail(fmt::format("{}: {}", config_.source, e.what()));
+    }
+  }
+
+ private:
+  Result<void> open_source() {
+    const bool camera = is_camera_index(config_.source);
+    capture_ = std::make_unique<cv::VideoCapture>();
+    const bool opened = camera ? capture_->open(std::stoi(config_.source), cv::CAP_V4L2)
+                               : capture_->open(config_.source);
+    if (!opened || !capture_->isOpened())
+      return fail(camera ? fmt::format("cannot open camera {} (V4L2 /dev/video{})", config_.source,
+                                       config_.source)
+                         : fmt::format("cannot open video source '{}' (no such file, or not a "
+                                       "video / image sequence OpenCV can read)",
+                                       config_.source));
+    is_camera_ = camera;
+    return {};
+  }
+
+  Result<void> run_checked(SampleSink& sink, std::stop_token stop) {
+    auto camera = load_camera_model(config_.calibration);
+    if (!camera) return std::unexpected(camera.error());
+    camera_ = *camera;
+    auto detector = TagDetector::create(config_.detector);
+    if (!detector) return std::unexpected(detector.error());
+    detector_ = std::move(*detector);
+    if (auto opened = open_source(); !opened) return opened;
+
+    using namespace std::chrono;
+    auto next = steady_clock::now();
+    std::uint64_t frames_in_pass = 0;
+    cv::Mat frame, gray;
+    for (std::uint32_t index = 0; !stop.stop_requested(); ++index) {
+      if (!is_camera_ && config_.rate_hz > 0) {
+        next += duration_cast<steady_clock::duration>(duration<double>(1.0 / config_.rate_hz));
+        if (!sleep_until(stop, next)) return {};
+      }
+      if (!capture_->read(frame) || frame.empty()) {
+        if (is_camera_) return fail(fmt::format("camera {} stopped delivering frames", config_.source));
+        if (frames_in_pass == 0)
+          return fail(fmt::format("'{}': no frame could be decoded (corrupt or empty video)",
+                                  config_.source));
+        if (!config_.loop) {
+          sleep_for(stop, milliseconds(50));  // idle until stopped
+          --index;
+          continue;
+        }
+        if (auto reopened = open_source(); !reopened) return reopened;
+        frames_in_pass = 0;
+        continue;
+      }
+      ++frames_in_pass;
+      const std::int64_t time_us = now_us();
+      if (frame.channels() == 3) cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
+      else if (frame.channels() == 4) cv::cvtColor(frame, gray, cv::COLOR_BGRA2GRAY);
+      else gray = frame;
+      if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
+      if (gray.cols != camera_.width_px || gray.rows != camera_.height_px)
+        return fail(fmt::format("'{}': frame is {}x{} but the calibration '{}' is for {}x{}",
+                                config_.source, gray.cols, gray.rows, config_.calibration,
+                                camera_.width_px, camera_.height_px));
+      process(sink, gray, index, time_us);
+    }
+    return {};
+  }
+
+  void process(SampleSink& sink, const cv::Mat& gray, std::uint32_t index, std::int64_t time_us) {
+    RawFrame raw{index, time_us, estimate_image_noise(gray), {}};
+    std::set<int> seen;
+    for (const Detection& det : detector_->detect(gray)) {
+      const auto size = config_.tag_size_m.find(det.id);
+      if (size == config_.tag_size_m.end() || seen.count(det.id)) continue;
+      const int cells = detector_->family().cells_across_border();
+      const double contrast = tag_contrast(gray, det.corners_px, cells);
+      const double sigma = config_.noise.sigma_px(raw.image_noise, contrast,
+                                                  mean_edge_length_px(det.corners_px),
+                                                  edge_axis_alignment(det.corners_px));
+      const CornerNoise noise{sigma, config_.noise.radial_bias_px, config_.noise.radial_sigma_px};
+      auto pose = estimate_tag_pose(camera_, det.corners_px, size->second, noise, config_.ambiguity_chi2);
+      if (!pose) {
+        sink.count_error(fmt::format("tag {}: {}", det.id, pose.error().message));
+        continue;
+      }
+      seen.insert(det.id);
+      RawTag rt{det, contrast, {pose->best}};
+      if (pose->second) rt.solutions.push_back(*pose->second);
+      raw.tags.push_back(rt);
+
+      const std::string sensor = fmt::format("tag{}", det.id);
+      PoseSample s{sensor, config_.parent_frame, sensor, time_us};
+      s.T_parent_child = pose->best.T_camera_tag;
+      s.covariance = pose->covariance;
+      s.status = pose->ambiguous ? TrackingStatus::Degraded : TrackingStatus::Ok;
+      last_pose_[det.id] = s.T_parent_child;
+      sink.pose(s);
+    }
+    // Tags seen before and not now: LOST, so that a client tells "not seen" from "lost message".
+    for (const auto& [id, last] : last_pose_) {
+      if (seen.count(id)) continue;
+      const std::string sensor = fmt::format("tag{}", id);
+      PoseSample s{sensor, config_.parent_frame, sensor, time_us};
+      s.T_parent_child = last;
+      s.covariance = Mat6::Identity() * std::numeric_limits<double>::infinity();
+      s.status = TrackingStatus::Lost;
+      sink.pose(s);
+    }
+    if (config_.publish_raw) {
+      const auto bytes = encode_raw_frame(raw);
+      sink.raw(ByteDirection::FromDevice, bytes.data(), bytes.size());
+    }
+  }
+
+  FiducialConfig config_;
+  CameraModel camera_;
+  std::unique_ptr<TagDetector> detector_;
+  std::unique_ptr<cv::VideoCapture> capture_;
+  bool is_camera_ = false;
+  std::map<int, Pose> last_pose_;
+};
+
+}  // namespace
+
+std::unique_ptr<Driver> make_fiducial_driver(const FiducialConfig& config, std::uint64_t) {
+  return std::make_unique<FiducialDriver>(config);
+}
+
+}  // namespace covtrack::fiducial

@@ -1,0 +1,139 @@
+#include "covtrack/devices/fiducial/tag_pose.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Cholesky>
+#include <fmt/format.h>
+#include <opencv2/calib3d.hpp>
+
+namespace covtrack::fiducial {
+namespace {
+
+// AprilTag 3's corner order, which is also the order SOLVEPNP_IPPE_SQUARE requires.
+std::array<Vec3, 4> tag_corners(double size_m) {
+  const double h = size_m / 2;
+  return {Vec3(-h, h, 0), Vec3(h, h, 0), Vec3(h, -h, 0), Vec3(-h, -h, 0)};
+}
+
+Pose pose_of(const cv::Mat& rvec, const cv::Mat& tvec) {
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  Pose T = Pose::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) T.linear()(r, c) = R.at<double>(r, c);
+    T.translation()[r] = tvec.at<double>(r);
+  }
+  return T;
+}
+
+double sse(const CameraModel& cam, const Pose& T, const std::array<Vec3, 4>& object,
+           const std::vector<cv::Point2d>& image) {
+  double s = 0;
+  for (int i = 0; i < 4; ++i) {
+    const Vec3 p = T * object[i];
+    if (p.z() <= 0) return std::numeric_limits<double>::infinity();
+    const cv::Point2d d = cam.project(p) - image[i];
+    s += d.dot(d);
+  }
+  return s;
+}
+
+}  // namespace
+
+CornerJacobian corner_jacobian(const CameraModel& cam, const Pose& T, double size_m) {
+  CornerJacobian J;
+  const Mat3 R = T.rotation();
+  const auto corners = tag_corners(size_m);
+  for (int i = 0; i < 4; ++i) {
+    const Vec3& X = corners[i];
+    const Vec3 p = T * X;
+    // T Exp(xi) X ~ T (X + rho + phi x X): dp/dxi = R [I, -[X]x].
+    Eigen::Matrix<double, 3, 6> dp;
+    dp << R, -R * skew(X);
+    Eigen::Matrix<double, 2, 3> du;
+    const double iz = 1 / p.z();
+    du << cam.fx * iz, 0, -cam.fx * p.x() * iz * iz, 0, cam.fy * iz, -cam.fy * p.y() * iz * iz;
+    J.block<2, 6>(2 * i, 0) = du * dp;
+  }
+  return J;
+}
+
+Mat6 pose_covariance(const CornerJacobian& J, double sigma) {
+  const Mat6 information = J.transpose() * J;
+  Mat6 cov = information.ldlt().solve(Mat6::Identity()) * (sigma * sigma);
+  return (cov + cov.transpose()) / 2;
+}
+
+Mat6 pose_covariance(const CornerJacobian& J, const Eigen::Matrix<double, 8, 8>& corner_covariance) {
+  const Mat6 information = J.transpose() * corner_covariance.ldlt().solve(J);
+  Mat6 cov = information.ldlt().solve(Mat6::Identity());
+  return (cov + cov.transpose()) / 2;
+}
+
+Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::Point2d, 4>& c,
+                                  double size_m, const CornerNoise& noise, double ambiguity_chi2) {
+  const double sigma = noise.sigma_px;
+  for (const auto& p : c)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y))
+      return fail("tag corner is not a finite number");
+  if (!(size_m > 0) || !(sigma > 0)) return fail("tag size and corner sigma must be positive");
+  std::vector<cv::Point2d> image(c.begin(), c.end());
+  if (cam.has_distortion()) cv::undistortPoints(image, image, cam.K(), cam.distortion, cv::noArray(), cam.K());
+  const double area = std::abs((image[2] - image[0]).cross(image[3] - image[1])) / 2;
+  if (!(area > 4)) return fail(fmt::format("tag quad is degenerate (area {:.2f} px^2)", area));
+  // The common radial error: remove its mean, keep its spread for Sigma_c.
+  const cv::Point2d centre = (image[0] + image[1] + image[2] + image[3]) / 4.0;
+  Eigen::Matrix<double, 8, 1> radial;
+  for (int i = 0; i < 4; ++i) {
+    cv::Point2d r = image[i] - centre;
+    r /= std::max(std::hypot(r.x, r.y), 1e-9);
+    radial(2 * i) = r.x, radial(2 * i + 1) = r.y;
+    image[i] -= noise.radial_bias_px * r;
+  }
+  const Eigen::Matrix<double, 8, 8> corner_cov =
+      sigma * sigma * Eigen::Matrix<double, 8, 8>::Identity() +
+      noise.radial_sigma_px * noise.radial_sigma_px * radial * radial.transpose();
+
+  const auto object = tag_corners(size_m);
+  std::vector<cv::Point3d> obj;
+  for (const Vec3& X : object) obj.emplace_back(X.x(), X.y(), X.z());
+  const cv::Mat K(cam.K());
+  std::vector<cv::Mat> rvecs, tvecs;
+  std::vector<PoseSolution> solutions;
+  try {
+    cv::solvePnPGeneric(obj, image, K, cv::noArray(), rvecs, tvecs, false, cv::SOLVEPNP_IPPE_SQUARE);
+    for (std::size_t i = 0; i < rvecs.size(); ++i) {
+      cv::solvePnPRefineLM(obj, image, K, cv::noArray(), rvecs[i], tvecs[i]);
+      const Pose T = pose_of(rvecs[i], tvecs[i]);
+      const double e = sse(cam, T, object, image);
+      if (std::isfinite(e)) solutions.push_back({T, e});
+    }
+  } catch (const cv::Exception& e) {
+    return fail(fmt::format("pose from tag corners failed: {}", e.what()));
+  }
+  if (solutions.empty()) return fail("no pose puts the tag in front of the camera");
+  std::sort(solutions.begin(), solutions.end(),
+            [](const PoseSolution& a, const PoseSolution& b) { return a.sse_px2 < b.sse_px2; });
+
+  TagPose out;
+  out.best = solutions[0];
+  out.corner_sigma_px = sigma;
+  out.covariance = pose_covariance(corner_jacobian(cam, out.best.T_camera_tag, size_m), corner_cov);
+  out.ambiguity_chi2 = std::numeric_limits<double>::infinity();
+  if (solutions.size() > 1) {
+    out.second = solutions[1];
+    out.ambiguity_chi2 = (solutions[1].sse_px2 - solutions[0].sse_px2) / (sigma * sigma);
+    if (out.ambiguity_chi2 < ambiguity_chi2) {
+      // The data cannot tell the two apart: cover the step to the other one as well.
+      const Vec6 d = boxminus(solutions[1].T_camera_tag, out.best.T_camera_tag);
+      out.covariance += d * d.transpose();
+      out.ambiguous = true;
+    }
+  }
+  if (!out.covariance.allFinite()) return fail("pose covariance is not finite (degenerate view)");
+  return out;
+}
+
+}  // namespace covtrack::fiducial

@@ -1,0 +1,171 @@
+// The fiducial driver on rendered image sequences: poses near the truth with finite
+// covariances, decodable raw detections, and clear errors for a missing camera, an
+// unreadable calibration and a corrupt video.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "covtrack/devices/fiducial/fiducial_config.hpp"
+#include "covtrack/devices/fiducial/fiducial_driver.hpp"
+#include "covtrack/devices/fiducial/raw_detection.hpp"
+#include "covtrack/devices/fiducial/tag_renderer.hpp"
+#include "fiducial_scene.hpp"
+
+using namespace covtrack;
+using namespace covtrack::fiducial;
+namespace fs = std::filesystem;
+
+namespace {
+
+class Sink : public SampleSink {
+ public:
+  void pose(const PoseSample& s) override { std::lock_guard l(m); poses.push_back(s); }
+  void truth(const TruthSample&) override {}
+  void raw(ByteDirection, const std::uint8_t* d, std::size_t n) override {
+    std::lock_guard l(m);
+    raws.emplace_back(d, d + n);
+  }
+  void count_error(const std::string&) override { ++errors; }
+  void count_resync() override {}
+  void count_drop() override {}
+  std::size_t raw_count() { std::lock_guard l(m); return raws.size(); }
+  std::mutex m;
+  std::vector<PoseSample> poses;
+  std::vector<std::vector<std::uint8_t>> raws;
+  int errors = 0;
+};
+
+struct Scene {
+  fs::path dir;
+  std::vector<RenderedTag> tags;
+};
+
+Scene render_sequence(const std::string& name, int frames) {
+  Scene s;
+  s.dir = fs::path(::testing::TempDir()) / fmt::format("fiducial_{}_{}", name, getpid());
+  fs::create_directories(s.dir);
+  const CameraModel cam = test::small_camera();
+  EXPECT_TRUE(save_camera_model(cam, s.dir / "camera.yml").has_value());
+  auto family = TagFamily::open("tag36h11");
+  s.tags = {{2, 0.1, test::tag_pose(0.8, 25, 10, 30, -0.1, 0)},
+            {9, 0.1, test::tag_pose(1.0, -20, -5, 60, 0.15, 0.05)}};
+  const cv::Mat clean = render_tags(cam, **family, s.tags, RenderLook{});
+  std::mt19937_64 rng(3);
+  for (int f = 0; f < frames; ++f)
+    cv::imwrite((s.dir / fmt::format("frame_{:04d}.png", f)).string(), add_sensor_noise(clean, 3, rng));
+  return s;
+}
+
+FiducialConfig config_for(const Scene& s) {
+  FiducialConfig c;
+  c.device = "cam";
+  c.source = (s.dir / "frame_%04d.png").string();
+  c.calibration = (s.dir / "camera.yml").string();
+  c.detector.decimate = 1;
+  c.rate_hz = 0;
+  c.loop = false;
+  c.tag_size_m = {{2, 0.1}, {9, 0.1}};
+  return c;
+}
+
+// Runs the driver until it returns, or until `frames` raw records arrived (then stops it).
+Result<void> run_driver(const FiducialConfig& c, Sink& sink, std::size_t frames) {
+  auto driver = make_fiducial_driver(c, 0);
+  std::stop_source stop;
+  Result<void> result;
+  std::thread t([&] { result = driver->run(sink, stop.get_token()); });
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (sink.raw_count() < frames && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (!result.has_value()) break;
+  }
+  stop.request_stop();
+  t.join();
+  return result;
+}
+
+}  // namespace
+
+TEST(FiducialDriver, ReportsEachMappedTagNearItsTruthWithRawDetections) {
+  const Scene s = render_sequence("ok", 5);
+  Sink sink;
+  auto r = run_driver(config_for(s), sink, 5);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  ASSERT_EQ(sink.raws.size(), 5u);
+  ASSERT_EQ(sink.poses.size(), 10u);
+  for (const PoseSample& p : sink.poses) {
+    const auto& truth = p.sensor == "tag2" ? s.tags[0] : s.tags[1];
+    ASSERT_TRUE(p.sensor == "tag2" || p.sensor == "tag9") << p.sensor;
+    EXPECT_NE(p.status, TrackingStatus::Lost);
+    EXPECT_TRUE(p.covariance.allFinite());
+    const Vec6 e = boxminus(truth.T_camera_tag, p.T_parent_child);
+    EXPECT_LT(e.dot(p.covariance.ldlt().solve(e)), 30.0) << p.sensor;
+    EXPECT_LT(e.head<3>().norm(), 0.02) << p.sensor;
+  }
+  const auto raw = decode_raw_frame(sink.raws[0].data(), sink.raws[0].size());
+  ASSERT_TRUE(raw.has_value());
+  ASSERT_EQ(raw->tags.size(), 2u);
+  EXPECT_GE(raw->tags[0].solutions.size(), 1u);
+  EXPECT_GT(raw->image_noise, 1.0);
+  // Truncated records are rejected, not misread.
+  EXPECT_FALSE(decode_raw_frame(sink.raws[0].data(), sink.raws[0].size() - 1).has_value());
+}
+
+TEST(FiducialDriver, MissingCameraIsAClearError) {
+  const Scene s = render_sequence("cam", 1);
+  FiducialConfig c = config_for(s);
+  c.source = "63";  // no /dev/video63 here
+  Sink sink;
+  auto r = run_driver(c, sink, 1);
+  ASSERT_FALSE(r.has_value());
+  EXPECT_NE(r.error().message.find("cannot open camera 63"), std::string::npos) << r.error().message;
+}
+
+TEST(FiducialDriver, UnreadableCalibrationIsAClearError) {
+  const Scene s = render_sequence("calib", 1);
+  FiducialConfig c = config_for(s);
+  std::ofstream(s.dir / "bad.yml") << "%YAML:1.0\n---\nimage_width: [unclosed\n";
+  c.calibration = (s.dir / "bad.yml").string();
+  Sink sink;
+  auto r = run_driver(c, sink, 1);
+  ASSERT_FALSE(r.has_value());
+  EXPECT_NE(r.error().message.find("bad.yml"), std::string::npos) << r.error().message;
+  c.calibration = (s.dir / "absent.yml").string();
+  r = run_driver(c, sink, 1);
+  ASSERT_FALSE(r.has_value());
+  EXPECT_NE(r.error().message.find("absent.yml: calibration file not found"), std::string::npos)
+      << r.error().message;
+}
+
+TEST(FiducialDriver, CorruptVideoIsAClearError) {
+  const Scene s = render_sequence("video", 1);
+  FiducialConfig c = config_for(s);
+  std::ofstream out(s.dir / "corrupt.avi", std::ios::binary);
+  out << "RIFF\x10\x00\x00\x00" << "AVI garbage, not a video at all";
+  out.close();
+  c.source = (s.dir / "corrupt.avi").string();
+  Sink sink;
+  auto r = run_driver(c, sink, 1);
+  ASSERT_FALSE(r.has_value());
+  EXPECT_NE(r.error().message.find("corrupt.avi"), std::string::npos) << r.error().message;
+}
+
+TEST(FiducialDriver, ConfigErrorsNameTheKey) {
+  auto toml = parse_toml("type = \"fiducial\"\nsource = \"x.png\"\ncalibration = \"c.yml\"\n"
+                         "family = \"tag99\"\n", "test.toml");
+  ASSERT_TRUE(toml.has_value());
+  ConfigErrors errors;
+  TableReader r(*toml, "devices.cam", fiducial_device_spec(), "dir/test.toml", errors);
+  const FiducialConfig c = read_fiducial_config(r, "cam");
+  EXPECT_EQ(c.calibration, "dir/c.yml");  // relative to the config file
+  const std::string all = errors.joined();
+  EXPECT_NE(all.find("unknown AprilTag family 'tag99'"), std::string::npos) << all;
+  EXPECT_NE(all.find("devices.cam.tags"), std::string::npos) << all;
+}

@@ -1,0 +1,145 @@
+// `covtrack render-tags`: AprilTags at known poses through a pinhole camera, with blur
+// and noise, written as an image sequence (or a video) plus a truth file. The fiducial
+// tracker's emulated camera: point its `source` at the output.
+#include <cmath>
+#include <filesystem>
+#include <optional>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "commands.hpp"
+#include "covtrack/devices/fiducial/tag_renderer.hpp"
+
+namespace covtrack::cli {
+namespace {
+
+struct RenderArgs {
+  std::string camera, family = "tag36h11", out, video;
+  std::vector<std::string> tags;
+  int frames = 60;
+  double swing_deg = 20, period_frames = 60;
+  double noise = 3, blur = 0.8, black = 30, white = 220, background = 128;
+  std::uint64_t seed = 1;
+};
+
+// "id,size_m,x,y,z,roll_deg,pitch_deg,yaw_deg": T_camera_tag, angles applied as
+// Rz(roll) Ry(yaw) Rx(pitch) in the camera frame.
+std::optional<fiducial::RenderedTag> parse_tag(const std::string& text, std::string& error) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      error = fmt::format("--tag '{}': '{}' is not a number", text, item);
+      return std::nullopt;
+    }
+  }
+  if (v.size() != 8 || v[0] < 0 || !(v[1] > 0) || !(v[4] > 0)) {
+    error = fmt::format("--tag '{}': expected id,size_m,x,y,z,roll_deg,pitch_deg,yaw_deg with "
+                        "size_m > 0 and z > 0",
+                        text);
+    return std::nullopt;
+  }
+  const double k = M_PI / 180;
+  fiducial::RenderedTag t;
+  t.id = static_cast<int>(v[0]);
+  t.size_m = v[1];
+  t.T_camera_tag = Pose::Identity();
+  t.T_camera_tag.linear() = (Eigen::AngleAxisd(v[5] * k, Vec3::UnitZ()) *
+                             Eigen::AngleAxisd(v[7] * k, Vec3::UnitY()) *
+                             Eigen::AngleAxisd(v[6] * k, Vec3::UnitX())).toRotationMatrix();
+  t.T_camera_tag.translation() = Vec3(v[2], v[3], v[4]);
+  return t;
+}
+
+int run_render(const RenderArgs& a) {
+  auto camera = fiducial::load_camera_model(a.camera);
+  if (!camera) return fmt::print(stderr, "covtrack render-tags: {}\n", camera.error().message), 2;
+  if (camera->has_distortion())
+    fmt::print(stderr, "covtrack render-tags: note: {} has lens distortion; frames are rendered "
+                       "through its pinhole part only\n", a.camera);
+  auto family = fiducial::TagFamily::open(a.family);
+  if (!family) return fmt::print(stderr, "covtrack render-tags: {}\n", family.error().message), 2;
+  std::vector<fiducial::RenderedTag> tags;
+  for (const auto& text : a.tags) {
+    std::string error;
+    auto t = parse_tag(text, error);
+    if (!t) return fmt::print(stderr, "covtrack render-tags: {}\n", error), 2;
+    if (!(*family)->cells(t->id))
+      return fmt::print(stderr, "covtrack render-tags: {}\n", (*family)->cells(t->id).error().message), 2;
+    tags.push_back(*t);
+  }
+  std::filesystem::create_directories(a.out);
+  cv::VideoWriter video;
+  if (!a.video.empty()) {
+    // FFV1 is lossless, so the noise in the frames is exactly the rendered noise.
+    video.open(a.video, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30,
+               {camera->width_px, camera->height_px}, false);
+    if (!video.isOpened())
+      return fmt::print(stderr, "covtrack render-tags: cannot write video '{}'\n", a.video), 2;
+  }
+  std::ofstream truth(std::filesystem::path(a.out) / "truth.csv");
+  truth << "# frame,id,size_m,x_m,y_m,z_m,qw,qx,qy,qz  (T_camera_tag; camera: OpenCV frame)\n";
+  fiducial::RenderLook look;
+  look.black = a.black, look.white = a.white, look.background = a.background;
+  look.blur_sigma_px = a.blur;
+  std::mt19937_64 rng(a.seed);
+  for (int f = 0; f < a.frames; ++f) {
+    // Each tag swings about its own vertical axis, so the frames show motion.
+    const double swing = a.swing_deg * M_PI / 180 * std::sin(2 * M_PI * f / a.period_frames);
+    std::vector<fiducial::RenderedTag> now = tags;
+    for (auto& t : now) {
+      t.T_camera_tag.linear() = t.T_camera_tag.linear() * Eigen::AngleAxisd(swing, Vec3::UnitY()).toRotationMatrix();
+      const Eigen::Quaterniond q(t.T_camera_tag.rotation());
+      const Vec3 p = t.T_camera_tag.translation();
+      truth << fmt::format("{},{},{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f}\n", f, t.id,
+                           t.size_m, p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z());
+    }
+    const cv::Mat image = fiducial::add_sensor_noise(
+        fiducial::render_tags(*camera, **family, now, look), a.noise, rng);
+    if (video.isOpened()) video.write(image);
+    else cv::imwrite((std::filesystem::path(a.out) / fmt::format("frame_{:04d}.png", f)).string(), image);
+  }
+  fmt::print("covtrack render-tags: {} frames -> {}{}\n", a.frames,
+             a.video.empty() ? a.out + "/frame_%04d.png" : a.video, ", truth in " + a.out + "/truth.csv");
+  return 0;
+}
+
+}  // namespace
+
+void add_render_tags_command(CLI::App& app) {
+  auto args = std::make_shared<RenderArgs>();
+  CLI::App* cmd = app.add_subcommand("render-tags", "render AprilTags at known poses (images or "
+                                                    "video + truth.csv): the fiducial emulator");
+  cmd->add_option("--camera", args->camera, "OpenCV calibration file")->required();
+  cmd->add_option("--out", args->out, "output folder (frames and truth.csv)")->required();
+  cmd->add_option("--tag", args->tags, "id,size_m,x,y,z,roll_deg,pitch_deg,yaw_deg (T_camera_tag; "
+                                       "repeat for more tags)")->required();
+  cmd->add_option("--family", args->family, "AprilTag family")->capture_default_str();
+  cmd->add_option("--video", args->video, "write this video file (FFV1) instead of PNG frames");
+  cmd->add_option("--frames", args->frames, "frame count")->capture_default_str()->check(CLI::Range(1, 1000000));
+  cmd->add_option("--swing-deg", args->swing_deg, "yaw swing amplitude")->capture_default_str();
+  cmd->add_option("--period-frames", args->period_frames, "frames per swing")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--noise", args->noise, "sensor noise sigma (grey levels)")->capture_default_str()->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--blur", args->blur, "optical blur sigma (px)")->capture_default_str()->check(CLI::Range(0.0, 20.0));
+  cmd->add_option("--black", args->black, "tag black level")->capture_default_str();
+  cmd->add_option("--white", args->white, "tag white level")->capture_default_str();
+  cmd->add_option("--background", args->background, "background level")->capture_default_str();
+  cmd->add_option("--seed", args->seed, "noise seed")->capture_default_str();
+  cmd->callback([args] {
+    const int rc = run_render(*args);
+    if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+}
+
+}  // namespace covtrack::cli
