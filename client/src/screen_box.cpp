@@ -1,0 +1,75 @@
+#include "covtrack/client/screen_box.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace covtrack::client {
+
+Box box_at_center(const Vec2& center_px, const Vec2& size_px) {
+  return {center_px - 0.5 * size_px, center_px + 0.5 * size_px};
+}
+
+Box box_at_corner(const Vec2& min_px, const Vec2& size_px) { return {min_px, min_px + size_px}; }
+
+bool boxes_overlap(const Box& a, const Box& b) {
+  return a.min.x() < b.max.x() && b.min.x() < a.max.x() && a.min.y() < b.max.y() &&
+         b.min.y() < a.max.y();
+}
+
+bool box_inside(const Box& inner, const Box& outer, double tol) {
+  return inner.min.x() >= outer.min.x() - tol && inner.min.y() >= outer.min.y() - tol &&
+         inner.max.x() <= outer.max.x() + tol && inner.max.y() <= outer.max.y() + tol;
+}
+
+Polygon box_polygon(const Box& b) {
+  return {b.min, Vec2(b.max.x(), b.min.y()), b.max, Vec2(b.min.x(), b.max.y())};
+}
+
+namespace {
+// Projections of a point set onto an axis: [lo, hi].
+void project(const Polygon& points, const Vec2& axis, double& lo, double& hi) {
+  lo = hi = axis.dot(points.front());
+  for (const Vec2& p : points) {
+    const double d = axis.dot(p);
+    lo = std::min(lo, d);
+    hi = std::max(hi, d);
+  }
+}
+}  // namespace
+
+bool box_meets_convex(const Box& box, const Polygon& convex) {
+  if (convex.size() < 3) return false;
+  const Polygon corners = box_polygon(box);
+  // Two convex sets have disjoint interiors iff some edge normal of one separates them;
+  // the box's normals are the two coordinate axes.
+  std::vector<Vec2> axes = {Vec2(1, 0), Vec2(0, 1)};
+  for (std::size_t i = 0, n = convex.size(); i < n; ++i) {
+    const Vec2 e = convex[(i + 1) % n] - convex[i];
+    if (e.squaredNorm() > 0) axes.emplace_back(e.y(), -e.x());
+  }
+  for (const Vec2& axis : axes) {
+    double a_lo, a_hi, b_lo, b_hi;
+    project(corners, axis, a_lo, a_hi);
+    project(convex, axis, b_lo, b_hi);
+    // Touching (within rounding of the coordinates) counts as separated.
+    const double tol = 1e-9 * (1 + std::abs(a_lo) + std::abs(b_hi));
+    if (a_hi <= b_lo + tol || b_hi <= a_lo + tol) return false;
+  }
+  return true;
+}
+
+Vec2 nearest_point_on_box(const Box& b, const Vec2& p) {
+  return {std::clamp(p.x(), b.min.x(), b.max.x()), std::clamp(p.y(), b.min.y(), b.max.y())};
+}
+
+Box bounding_box(const Polygon& polygon) {
+  if (polygon.empty()) return {};
+  Box b{polygon.front(), polygon.front()};
+  for (const Vec2& p : polygon) {
+    b.min = b.min.cwiseMin(p);
+    b.max = b.max.cwiseMax(p);
+  }
+  return b;
+}
+
+}  // namespace covtrack::client
