@@ -50,7 +50,7 @@ std::optional<Box> place_outside(const Polygon& outer, const Vec2& size,
   if (!o.policy) return std::nullopt;
   for (const Box& box : o.policy(bounding_box(outer), size, o.screen, o.gap_px))
     if (box.min.allFinite() && box.max.allFinite() && box_inside(box, o.screen) &&
-        !box_meets_convex(box, outer) && clear_of(box, placed))
+        clear_of(box, placed) && !box_meets_convex(box, outer))
       return box;
   return std::nullopt;
 }

@@ -1,6 +1,7 @@
 #include "covtrack/client/screen_box.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace covtrack::client {
@@ -27,33 +28,38 @@ Polygon box_polygon(const Box& b) {
 
 namespace {
 // Projections of a point set onto an axis: [lo, hi].
-void project(const Polygon& points, const Vec2& axis, double& lo, double& hi) {
-  lo = hi = axis.dot(points.front());
+template <typename Points>
+void project(const Points& points, const Vec2& axis, double& lo, double& hi) {
+  lo = hi = axis.dot(points[0]);
   for (const Vec2& p : points) {
     const double d = axis.dot(p);
     lo = std::min(lo, d);
     hi = std::max(hi, d);
   }
 }
+
+bool separates(const std::array<Vec2, 4>& corners, const Polygon& convex, const Vec2& axis) {
+  double a_lo, a_hi, b_lo, b_hi;
+  project(corners, axis, a_lo, a_hi);
+  project(convex, axis, b_lo, b_hi);
+  // Touching (within rounding of the coordinates) counts as separated.
+  const double tol = 1e-9 * (1 + std::abs(a_lo) + std::abs(b_hi));
+  return a_hi <= b_lo + tol || b_hi <= a_lo + tol;
+}
 }  // namespace
 
 bool box_meets_convex(const Box& box, const Polygon& convex) {
   if (convex.size() < 3) return false;
-  const Polygon corners = box_polygon(box);
+  // Called for every candidate label position: no allocation here.
+  const std::array<Vec2, 4> corners = {box.min, Vec2(box.max.x(), box.min.y()), box.max,
+                                       Vec2(box.min.x(), box.max.y())};
   // Two convex sets have disjoint interiors iff some edge normal of one separates them;
   // the box's normals are the two coordinate axes.
-  std::vector<Vec2> axes = {Vec2(1, 0), Vec2(0, 1)};
+  if (separates(corners, convex, Vec2(1, 0)) || separates(corners, convex, Vec2(0, 1)))
+    return false;
   for (std::size_t i = 0, n = convex.size(); i < n; ++i) {
     const Vec2 e = convex[(i + 1) % n] - convex[i];
-    if (e.squaredNorm() > 0) axes.emplace_back(e.y(), -e.x());
-  }
-  for (const Vec2& axis : axes) {
-    double a_lo, a_hi, b_lo, b_hi;
-    project(corners, axis, a_lo, a_hi);
-    project(convex, axis, b_lo, b_hi);
-    // Touching (within rounding of the coordinates) counts as separated.
-    const double tol = 1e-9 * (1 + std::abs(a_lo) + std::abs(b_hi));
-    if (a_hi <= b_lo + tol || b_hi <= a_lo + tol) return false;
+    if (e.squaredNorm() > 0 && separates(corners, convex, Vec2(e.y(), -e.x()))) return false;
   }
   return true;
 }

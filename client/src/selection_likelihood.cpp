@@ -28,6 +28,7 @@ std::vector<double> likelihoods_by_area(const Pointer& pointer, std::span<const 
   if (pointer.lost) return out;
   const bool has_area = is_usable_polygon(pointer.region) && polygon_area(pointer.region) > 0;
   const double pointer_area = has_area ? polygon_area(pointer.region) : 0;
+  const Box pointer_bounds = bounding_box(pointer.region);
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const Polygon& region = objects[i].region;
     if (!is_usable_polygon(region)) continue;
@@ -35,6 +36,8 @@ std::vector<double> likelihoods_by_area(const Pointer& pointer, std::span<const 
       out[i] = pointer.position_px.allFinite() && polygon_contains(region, pointer.position_px);
       continue;
     }
+    // Most objects are nowhere near the pointer: skip the intersection for them.
+    if (!boxes_overlap(pointer_bounds, bounding_box(region))) continue;
     const double shared = polygon_area(intersect_convex(pointer.region, region));
     out[i] = std::clamp(shared / pointer_area, 0.0, 1.0);
   }
