@@ -45,13 +45,32 @@ std::optional<Box> place_inside(const Polygon& inner, const Vec2& size, const Bo
   return std::nullopt;
 }
 
-std::optional<Box> place_outside(const Polygon& outer, const Vec2& size,
-                                 const LabelPlacerOptions& o, std::span<const Box> placed) {
+// Other objects' outer regions, with their bounding boxes for a cheap first test.
+struct Obstacles {
+  std::vector<const Polygon*> regions;
+  std::vector<Box> bounds;
+
+  bool meets(const Box& box, const Polygon* except) const {
+    for (std::size_t k = 0; k < regions.size(); ++k)
+      if (regions[k] != except && boxes_overlap(box, bounds[k]) && box_meets_convex(box, *regions[k]))
+        return true;
+    return false;
+  }
+};
+
+std::optional<Box> place_outside(const Polygon& outer, const Vec2& size, const LabelPlacerOptions& o,
+                                 std::span<const Box> placed, const Obstacles& others) {
   if (!o.policy) return std::nullopt;
-  for (const Box& box : o.policy(bounding_box(outer), size, o.screen, o.gap_px))
-    if (box.min.allFinite() && box.max.allFinite() && box_inside(box, o.screen) &&
-        clear_of(box, placed) && !box_meets_convex(box, outer))
-      return box;
+  const std::vector<Box> candidates = o.policy(bounding_box(outer), size, o.screen, o.gap_px);
+  // First a place that hides no other object either, then any place clear of its own.
+  for (const bool spare_others : {o.avoid_other_objects, false}) {
+    for (const Box& box : candidates)
+      if (box.min.allFinite() && box.max.allFinite() && box_inside(box, o.screen) &&
+          clear_of(box, placed) && !box_meets_convex(box, outer) &&
+          !(spare_others && others.meets(box, &outer)))
+        return box;
+    if (!spare_others) break;
+  }
   return std::nullopt;
 }
 
@@ -104,10 +123,14 @@ std::vector<PlacedLabel> place_labels(std::span<const LabelRequest> requests,
       }
     }
   }
+  Obstacles others;
+  if (o.avoid_other_objects)
+    for (const LabelRequest& r : requests)
+      if (is_usable_polygon(r.outer)) others.regions.push_back(&r.outer), others.bounds.push_back(bounding_box(r.outer));
   for (std::size_t i = 0; i < n; ++i) {
     if (done[i] || !is_usable_polygon(requests[i].outer)) continue;
     const Vec2 size = sane_size(requests[i].size_px);
-    if (auto box = place_outside(requests[i].outer, size, o, placed)) {
+    if (auto box = place_outside(requests[i].outer, size, o, placed, others)) {
       labels[i] = {*box, LabelPlacement::outside_outer, true, leader_to(*box, requests[i].outer),
                    true};
       placed.push_back(*box);

@@ -15,6 +15,11 @@ Pointer pointer_with_covariance(const Vec2& position, const Mat2& covariance, do
   return p;
 }
 
+Pointer pointer_from_projection(const ProjectedVertex& tip, double confidence, int sides) {
+  if (!tip.flags.usable()) return Pointer{tip.mean_px, {}, true};
+  return pointer_with_covariance(tip.mean_px, tip.covariance_px2, confidence, sides);
+}
+
 double pointer_error_px(const Pointer& pointer) {
   if (pointer.lost || !pointer.position_px.allFinite())
     return std::numeric_limits<double>::infinity();

@@ -137,6 +137,20 @@ TEST(LabelPlacer, ApplicationPolicyIsUsedAndItsBadCandidatesSkipped) {
   EXPECT_TRUE(labels[0].box.min.isApprox(Vec2(10, 400)));
 }
 
+TEST(LabelPlacer, OutsideLabelsPreferPlacesThatHideNoOtherObject) {
+  const Polygon a = square(200, 200, 260, 240), b = square(270, 205, 330, 235);
+  const std::vector<LabelRequest> requests = {{{}, a, Vec2(60, 20)}, {{}, b, Vec2(60, 20)}};
+  const auto spared = place_labels(requests, {.screen = kScreen});
+  ASSERT_EQ(spared[0].placement, LabelPlacement::outside_outer);
+  EXPECT_EQ(shared_area(spared[0].box, b), 0) << "a's label leaves b visible";
+  EXPECT_EQ(shared_area(spared[1].box, a), 0);
+  expect_no_overlaps(spared);
+  // Without the preference the first candidate (right of a) is taken although it hides b.
+  const auto plain = place_labels(requests, {.screen = kScreen, .avoid_other_objects = false});
+  EXPECT_GT(shared_area(plain[0].box, b), 0);
+  EXPECT_EQ(shared_area(plain[0].box, a), 0);
+}
+
 TEST(LabelPlacer, NeverInsideWhenTheApplicationForbidsCoveringObjects) {
   const Polygon outer = square(100, 100, 300, 250), inner = square(130, 130, 270, 220);
   const LabelRequest request{inner, outer, Vec2(40, 20)};

@@ -83,6 +83,21 @@ TEST(SelectionLikelihood, MatchesTheFractionOfPointerSamplesOnTheObject) {
   EXPECT_NEAR(l, fraction, 4 * std::sqrt(fraction * (1 - fraction) / in_pointer));
 }
 
+TEST(SelectionPointer, FromAProjectedTipItsEllipseOrLost) {
+  ProjectedVertex tip;
+  tip.mean_px = Vec2(100, 50);
+  tip.covariance_px2 << 16, 0, 0, 4;  // sigmas 4 and 2 px
+  const Pointer p = pointer_from_projection(tip, 0.95, 32);
+  EXPECT_FALSE(p.lost);
+  // The 95% ellipse's semi-major axis is 4 * 2.4477 px; the 32-gon holds it and adds < 0.5%.
+  EXPECT_GE(pointer_error_px(p), 4 * confidence_scale(0.95) - 1e-9);
+  EXPECT_LE(pointer_error_px(p), 4 * confidence_scale(0.95) / std::cos(3.14159265358979 / 32) + 1e-9);
+  EXPECT_TRUE(polygon_contains(p.region, Vec2(100 + 4 * 2.4, 50)));
+  EXPECT_FALSE(polygon_contains(p.region, Vec2(100, 50 + 2 * 2.5)));
+  tip.flags.unbounded = true;  // a LOST pose
+  EXPECT_TRUE(pointer_from_projection(tip).lost);
+}
+
 TEST(DirectSelection, MostLikelyFirstThenNearest) {
   const std::vector<Selectable> objects = {{{}, 3.0}, {{}, 1.0}, {{}, 2.0}, {{}, 0.5}};
   const std::vector<double> likelihoods = {0.4, 0.4, 0.9, 0.0};

@@ -39,7 +39,7 @@ struct PlacedLabel {
 
 // A placement policy: candidate label boxes outside the box `object_bounds` (the outer
 // region's bounding box), best first. The placer takes the first that is on screen, clear
-// of the outer region and of every label already placed.
+// of the outer region and of every label already placed (and, first, of other objects).
 using LabelPolicy = std::function<std::vector<Box>(const Box& object_bounds, const Vec2& label_size,
                                                    const Box& screen, double gap_px)>;
 
@@ -53,6 +53,9 @@ struct LabelPlacerOptions {
   bool allow_inside = true;  // false: never cover an object (outside or list only)
   LabelPolicy policy = fixed_order_policy();
   double gap_px = 4;  // between a label and its object's outer region, and in the list
+  // Outside labels: prefer places that cover no other object's outer region either, and
+  // only then fall back to places clear of their own object alone.
+  bool avoid_other_objects = true;
 };
 
 // One label per request, same order.

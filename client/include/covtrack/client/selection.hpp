@@ -29,6 +29,11 @@ struct Pointer {
 Pointer pointer_with_covariance(const Vec2& position_px, const Mat2& covariance_px2,
                                 double confidence = 0.95, int sides = 16);
 
+// A tracked 3-D pointer (e.g. a stylus tip) projected with project_vertex: its pixel and
+// pixel covariance; lost when the projection is unusable (LOST pose, behind the camera).
+Pointer pointer_from_projection(const ProjectedVertex& tip, double confidence = 0.95,
+                                int sides = 16);
+
 // How far the pointer can be off: the largest distance from its position to its region's
 // boundary. 0 for a region-less pointer; +inf when lost or the region is not finite.
 double pointer_error_px(const Pointer& pointer);
