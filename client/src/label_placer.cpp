@@ -49,29 +49,38 @@ std::optional<Box> place_inside(const Polygon& inner, const Vec2& size, const Bo
 struct Obstacles {
   std::vector<const Polygon*> regions;
   std::vector<Box> bounds;
-
-  bool meets(const Box& box, const Polygon* except) const {
-    for (std::size_t k = 0; k < regions.size(); ++k)
-      if (regions[k] != except && boxes_overlap(box, bounds[k]) && box_meets_convex(box, *regions[k]))
-        return true;
-    return false;
-  }
 };
 
 std::optional<Box> place_outside(const Polygon& outer, const Vec2& size, const LabelPlacerOptions& o,
                                  std::span<const Box> placed, const Obstacles& others) {
   if (!o.policy) return std::nullopt;
   const std::vector<Box> candidates = o.policy(bounding_box(outer), size, o.screen, o.gap_px);
-  // First a place that hides no other object either, then any place clear of its own.
-  for (const bool spare_others : {o.avoid_other_objects, false}) {
-    for (const Box& box : candidates)
-      if (box.min.allFinite() && box.max.allFinite() && box_inside(box, o.screen) &&
-          clear_of(box, placed) && !box_meets_convex(box, outer) &&
-          !(spare_others && others.meets(box, &outer)))
-        return box;
-    if (!spare_others) break;
+  // Only the objects near some candidate can be hidden by one.
+  std::vector<std::size_t> near;
+  if (o.avoid_other_objects && !candidates.empty()) {
+    Box reach = candidates.front();
+    for (const Box& box : candidates) reach.min = reach.min.cwiseMin(box.min), reach.max = reach.max.cwiseMax(box.max);
+    for (std::size_t k = 0; k < others.regions.size(); ++k)
+      if (others.regions[k] != &outer && boxes_overlap(reach, others.bounds[k]))
+        near.push_back(k);
   }
-  return std::nullopt;
+  const auto hides_another = [&](const Box& box) {
+    for (std::size_t k : near)
+      if (boxes_overlap(box, others.bounds[k]) && box_meets_convex(box, *others.regions[k]))
+        return true;
+    return false;
+  };
+  // The first place that hides no other object either; failing that, the first one
+  // clear of its own object.
+  std::optional<Box> fallback;
+  for (const Box& box : candidates) {
+    if (!(box.min.allFinite() && box.max.allFinite() && box_inside(box, o.screen) &&
+          clear_of(box, placed) && !box_meets_convex(box, outer)))
+      continue;
+    if (!hides_another(box)) return box;
+    if (!fallback) fallback = box;
+  }
+  return fallback;
 }
 
 std::array<Vec2, 2> leader_to(const Box& box, const Polygon& region) {

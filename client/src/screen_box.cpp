@@ -57,9 +57,16 @@ bool box_meets_convex(const Box& box, const Polygon& convex) {
   // the box's normals are the two coordinate axes.
   if (separates(corners, convex, Vec2(1, 0)) || separates(corners, convex, Vec2(0, 1)))
     return false;
+  // On its own outward edge normal the polygon reaches no further than the edge itself,
+  // so each edge is one O(1) test: the box wholly beyond the edge's line.
   for (std::size_t i = 0, n = convex.size(); i < n; ++i) {
     const Vec2 e = convex[(i + 1) % n] - convex[i];
-    if (e.squaredNorm() > 0 && separates(corners, convex, Vec2(e.y(), -e.x()))) return false;
+    if (e.squaredNorm() == 0) continue;
+    const Vec2 outward = Vec2(e.y(), -e.x()).normalized();
+    double box_lo = outward.dot(corners[0]);
+    for (const Vec2& c : corners) box_lo = std::min(box_lo, outward.dot(c));
+    const double edge = outward.dot(convex[i]);
+    if (box_lo >= edge - 1e-9 * (1 + std::abs(edge))) return false;
   }
   return true;
 }
