@@ -1,0 +1,33 @@
+#pragma once
+// Axis-aligned boxes in pixels (labels, selection targets, the screen) and their tests
+// against each other and against convex polygons.
+#include "covtrack/client/regions.hpp"
+
+namespace covtrack::client {
+
+struct Box {
+  Vec2 min = Vec2::Zero();  // top-left corner (u, v), px
+  Vec2 max = Vec2::Zero();  // bottom-right corner
+
+  double width() const { return max.x() - min.x(); }
+  double height() const { return max.y() - min.y(); }
+  Vec2 center() const { return 0.5 * (min + max); }
+};
+
+Box box_at_center(const Vec2& center_px, const Vec2& size_px);
+Box box_at_corner(const Vec2& min_px, const Vec2& size_px);
+
+// Interiors meet (boxes that only touch along an edge do not overlap).
+bool boxes_overlap(const Box& a, const Box& b);
+// `inner` lies within `outer` (within tolerance_px).
+bool box_inside(const Box& inner, const Box& outer, double tolerance_px = 1e-9);
+// The box as a counter-clockwise polygon.
+Polygon box_polygon(const Box& box);
+// The interiors of the box and of a convex polygon meet (separating-axis test).
+bool box_meets_convex(const Box& box, const Polygon& convex);
+// The point of the box nearest to `point` (the point itself when inside).
+Vec2 nearest_point_on_box(const Box& box, const Vec2& point);
+// Smallest box holding the polygon (a zero box for an empty one).
+Box bounding_box(const Polygon& polygon);
+
+}  // namespace covtrack::client

@@ -1,0 +1,166 @@
+#include "covtrack/client/label_placer.hpp"
+
+#include <cmath>
+
+#include "covtrack/client/convex_polygon.hpp"
+#include "covtrack/client/space_manager.hpp"
+
+namespace covtrack::client {
+namespace {
+
+// Sub-pixel slack for rounding in the clipped feasible polygon.
+constexpr double kInsideTolerancePx = 1e-6;
+
+bool box_inside_convex(const Box& box, const Polygon& convex) {
+  for (const Vec2& corner : box_polygon(box))
+    if (!polygon_contains(convex, corner, kInsideTolerancePx)) return false;
+  return true;
+}
+
+bool clear_of(const Box& box, std::span<const Box> placed) {
+  for (const Box& other : placed)
+    if (boxes_overlap(box, other)) return false;
+  return true;
+}
+
+Vec2 sane_size(const Vec2& size) {
+  return {std::isfinite(size.x()) ? std::max(size.x(), 0.0) : 0.0,
+          std::isfinite(size.y()) ? std::max(size.y(), 0.0) : 0.0};
+}
+
+std::optional<Box> place_inside(const Polygon& inner, const Vec2& size, const Box& screen,
+                                std::span<const Box> placed) {
+  const Polygon centers = feasible_label_centers(inner, size, screen);
+  if (centers.empty()) return std::nullopt;
+  // The middle of the feasible centres first (the label sits well inside), then its
+  // corners, which move the label as far as it can go when another label is in the way.
+  std::vector<Vec2> tries = {polygon_centroid(centers)};
+  tries.insert(tries.end(), centers.begin(), centers.end());
+  for (const Vec2& c : tries) {
+    const Box box = box_at_center(c, size);
+    if (box_inside_convex(box, inner) && box_inside(box, screen, kInsideTolerancePx) &&
+        clear_of(box, placed))
+      return box;
+  }
+  return std::nullopt;
+}
+
+// Other objects' outer regions, with their bounding boxes for a cheap first test.
+struct Obstacles {
+  std::vector<const Polygon*> regions;
+  std::vector<Box> bounds;
+};
+
+std::optional<Box> place_outside(const Polygon& outer, const Vec2& size, const LabelPlacerOptions& o,
+                                 std::span<const Box> placed, const Obstacles& others) {
+  if (!o.policy) return std::nullopt;
+  const std::vector<Box> candidates = o.policy(bounding_box(outer), size, o.screen, o.gap_px);
+  // Only the objects near some candidate can be hidden by one.
+  std::vector<std::size_t> near;
+  if (o.avoid_other_objects && !candidates.empty()) {
+    Box reach = candidates.front();
+    for (const Box& box : candidates) reach.min = reach.min.cwiseMin(box.min), reach.max = reach.max.cwiseMax(box.max);
+    for (std::size_t k = 0; k < others.regions.size(); ++k)
+      if (others.regions[k] != &outer && boxes_overlap(reach, others.bounds[k]))
+        near.push_back(k);
+  }
+  const auto hides_another = [&](const Box& box) {
+    for (std::size_t k : near)
+      if (boxes_overlap(box, others.bounds[k]) && box_meets_convex(box, *others.regions[k]))
+        return true;
+    return false;
+  };
+  // The first place that hides no other object either; failing that, the first one
+  // clear of its own object.
+  std::optional<Box> fallback;
+  for (const Box& box : candidates) {
+    if (!(box.min.allFinite() && box.max.allFinite() && box_inside(box, o.screen) &&
+          clear_of(box, placed) && !box_meets_convex(box, outer)))
+      continue;
+    if (!hides_another(box)) return box;
+    if (!fallback) fallback = box;
+  }
+  return fallback;
+}
+
+std::array<Vec2, 2> leader_to(const Box& box, const Polygon& region) {
+  const Vec2 object = polygon_centroid(region);
+  return {nearest_point_on_box(box, object), object};
+}
+
+}  // namespace
+
+Polygon feasible_label_centers(const Polygon& region, const Vec2& size, const Box& screen) {
+  if (!is_usable_polygon(region)) return {};
+  const Vec2 half = 0.5 * size;
+  Polygon centers = region;
+  for (std::size_t i = 0, n = region.size(); i < n && !centers.empty(); ++i) {
+    const Vec2 e = region[(i + 1) % n] - region[i];
+    if (e.squaredNorm() == 0) continue;
+    const Vec2 outward = Vec2(e.y(), -e.x()).normalized();
+    // The box corner farthest along the outward normal must stay behind the edge.
+    const double reach = std::abs(outward.x()) * half.x() + std::abs(outward.y()) * half.y();
+    centers = clip_half_plane(centers, outward, outward.dot(region[i]) - reach);
+  }
+  const std::array<std::pair<Vec2, double>, 4> screen_sides = {{
+      {Vec2(-1, 0), -(screen.min.x() + half.x())},
+      {Vec2(1, 0), screen.max.x() - half.x()},
+      {Vec2(0, -1), -(screen.min.y() + half.y())},
+      {Vec2(0, 1), screen.max.y() - half.y()},
+  }};
+  for (const auto& [normal, offset] : screen_sides)
+    if (!centers.empty()) centers = clip_half_plane(centers, normal, offset);
+  return centers;
+}
+
+std::vector<PlacedLabel> place_labels(std::span<const LabelRequest> requests,
+                                      const LabelPlacerOptions& o) {
+  const std::size_t n = requests.size();
+  std::vector<PlacedLabel> labels(n);
+  std::vector<bool> done(n, false);
+  std::vector<Box> placed;
+  // Inside labels first: they are the most constrained, and an outside label must not
+  // take the space an inner region offers.
+  if (o.allow_inside) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!is_usable_polygon(requests[i].inner)) continue;
+      const Vec2 size = sane_size(requests[i].size_px);
+      if (auto box = place_inside(requests[i].inner, size, o.screen, placed)) {
+        labels[i] = {*box, LabelPlacement::inside_inner, true, std::nullopt, true};
+        placed.push_back(*box);
+        done[i] = true;
+      }
+    }
+  }
+  Obstacles others;
+  if (o.avoid_other_objects)
+    for (const LabelRequest& r : requests)
+      if (is_usable_polygon(r.outer)) others.regions.push_back(&r.outer), others.bounds.push_back(bounding_box(r.outer));
+  for (std::size_t i = 0; i < n; ++i) {
+    if (done[i] || !is_usable_polygon(requests[i].outer)) continue;
+    const Vec2 size = sane_size(requests[i].size_px);
+    if (auto box = place_outside(requests[i].outer, size, o, placed, others)) {
+      labels[i] = {*box, LabelPlacement::outside_outer, true, leader_to(*box, requests[i].outer),
+                   true};
+      placed.push_back(*box);
+      done[i] = true;
+    }
+  }
+  std::vector<std::size_t> rest;
+  std::vector<Vec2> sizes;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!done[i]) rest.push_back(i), sizes.push_back(sane_size(requests[i].size_px));
+  const std::vector<Box> list = stack_in_corner(sizes, placed, o.screen, o.gap_px);
+  for (std::size_t k = 0; k < rest.size(); ++k) {
+    PlacedLabel& label = labels[rest[k]];
+    label.box = list[k];
+    label.placement = LabelPlacement::corner_list;
+    label.anchored = false;
+    if (is_usable_polygon(requests[rest[k]].outer))
+      label.leader = leader_to(list[k], requests[rest[k]].outer);
+    label.on_screen = box_inside(list[k], o.screen);
+  }
+  return labels;
+}
+
+}  // namespace covtrack::client
