@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "covtrack/client/label_placer.hpp"
+
 namespace covtrack::cli {
 namespace {
 
@@ -17,6 +19,10 @@ constexpr double kScale = 1 << kShift;
 const cv::Scalar kBlue(255, 120, 0), kGreen(0, 200, 0), kWhite(255, 255, 255),
     kGrey(160, 160, 160), kRed(0, 0, 255), kYellow(0, 230, 230), kLegend(210, 210, 210),
     kPanel(30, 30, 30);
+
+const int kFont = cv::FONT_HERSHEY_SIMPLEX;
+constexpr double kFontScale = 0.45;
+constexpr int kLabelPad = 2;
 
 cv::Point fixed_point(const client::Vec2& p) {
   return {cvRound(p.x() * kScale), cvRound(p.y() * kScale)};
@@ -34,6 +40,8 @@ void draw_polygon(cv::Mat& image, const client::Polygon& polygon, const cv::Scal
 
 void draw_regions(cv::Mat& image, const RegionsReport& report) {
   const double scale = client::confidence_scale(report.confidence);
+  std::vector<client::LabelRequest> labels;
+  std::vector<std::string> texts;
   for (const RegionsReport::Object& o : report.objects) {
     const client::ObjectRegions& r = o.regions;
     client::Polygon outline;
@@ -48,26 +56,40 @@ void draw_regions(cv::Mat& image, const RegionsReport& report) {
     }
     draw_polygon(image, r.outer, kGreen, 2);
     draw_polygon(image, r.inner, kWhite, 2);
-    if (r.vertices.empty() || !r.vertices.front().flags.usable()) continue;
-    const client::Vec2 at = r.vertices.front().mean_px;
-    const std::string label = r.valid ? fmt::format("{} {:.1f} px", o.name, r.assessment)
-                                      : fmt::format("{}: no region", o.name);
-    cv::putText(image, label, cv::Point(cvRound(at.x()) + 4, cvRound(at.y()) - 4),
-                cv::FONT_HERSHEY_SIMPLEX, 0.45, r.valid ? kYellow : kRed, 1, cv::LINE_AA);
+    texts.push_back(r.valid ? fmt::format("{} {:.1f} px", o.name, r.assessment) : fmt::format("{}: no region", o.name));
+    int baseline = 0;
+    const cv::Size text = cv::getTextSize(texts.back(), kFont, kFontScale, 1, &baseline);
+    labels.push_back({r.inner, r.outer, client::Vec2(text.width + 2 * kLabelPad, text.height + baseline + 2 * kLabelPad)});
+  }
+  // Labels by the seed's placer (5.6.3): inside the inner region when they fit, else
+  // outside the outer region with a leader line, else listed in the top-left corner.
+  client::LabelPlacerOptions options;
+  options.screen = {client::Vec2(0, 0), client::Vec2(image.cols, image.rows)};
+  const std::vector<client::PlacedLabel> placed = client::place_labels(labels, options);
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    const client::PlacedLabel& p = placed[i];
+    const bool valid = report.objects[i].regions.valid;
+    if (p.leader)
+      cv::line(image, fixed_point((*p.leader)[0]), fixed_point((*p.leader)[1]), kYellow, 1, cv::LINE_AA, kShift);
+    const cv::Rect box(cvRound(p.box.min.x()), cvRound(p.box.min.y()), cvRound(p.box.width()), cvRound(p.box.height()));
+    cv::rectangle(image, box, kPanel, cv::FILLED);
+    cv::putText(image, texts[i], cv::Point(box.x + kLabelPad, box.y + box.height - kLabelPad - 3), kFont,
+                kFontScale, valid ? kYellow : kRed, 1, cv::LINE_AA);
   }
 }
 
 void draw_legend(cv::Mat& image, const std::vector<std::string>& lines) {
+  // Bottom-left: the label placer lists unanchored labels in the top-left corner.
   constexpr int kLine = 16, kMargin = 6;
   int width = 0;
   for (const std::string& line : lines)
-    width = std::max(width, cv::getTextSize(line, cv::FONT_HERSHEY_SIMPLEX, 0.4, 1, nullptr).width);
-  const cv::Rect panel(0, 0, std::min(image.cols, width + 2 * kMargin),
-                       std::min(image.rows, int(lines.size()) * kLine + kMargin));
+    width = std::max(width, cv::getTextSize(line, kFont, 0.4, 1, nullptr).width);
+  const int height = std::min(image.rows, int(lines.size()) * kLine + kMargin);
+  const cv::Rect panel(0, image.rows - height, std::min(image.cols, width + 2 * kMargin), height);
   image(panel) = kPanel;
   for (std::size_t i = 0; i < lines.size(); ++i)
-    cv::putText(image, lines[i], cv::Point(kMargin, kLine * int(i + 1)), cv::FONT_HERSHEY_SIMPLEX,
-                0.4, kLegend, 1, cv::LINE_AA);
+    cv::putText(image, lines[i], cv::Point(kMargin, panel.y + kLine * int(i + 1) - 2), kFont, 0.4, kLegend, 1,
+                cv::LINE_AA);
 }
 
 Result<void> write_png(const cv::Mat& image, const std::string& path) {

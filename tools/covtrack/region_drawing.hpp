@@ -1,7 +1,8 @@
 #pragma once
 // Drawing a RegionsReport over an image, in the seed's colours: error ellipses blue, outer
 // regions green, inner regions white; the object's outline (the hull of its projected
-// vertices) grey, its label yellow; a legend in the top-left corner. Used by `covtrack regions --png` and
+// vertices) grey; labels (yellow) placed by the seed's label placer; a legend in the
+// bottom-left corner. Used by `covtrack regions --png` and
 // `covtrack view`.
 #include <string>
 #include <vector>
