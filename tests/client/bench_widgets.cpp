@@ -6,6 +6,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "bench_frame.hpp"
 #include "covtrack/client/label_placer.hpp"
 #include "covtrack/client/selection.hpp"
 
@@ -16,36 +17,15 @@ namespace {
 
 constexpr int kObjects = 100;
 
-struct Frame {
-  Camera camera;
-  std::vector<UncertainPose> poses;
-  std::vector<std::vector<Vec3>> vertices;
+struct Frame : test::BenchFrame {
   std::vector<ObjectRegions> regions;  // computed once, for the widget benchmarks
 };
 
 const Frame& frame() {
   static const Frame f = [] {
-    Frame f;
-    f.camera.fx = 552.31, f.camera.fy = 551.08, f.camera.cx = 318.74, f.camera.cy = 243.52;
-    f.camera.width_px = 640, f.camera.height_px = 480;
-    f.camera.k1 = -0.04127, f.camera.k2 = 0.1834, f.camera.k3 = -0.2915;
-    std::mt19937_64 rng(1);
-    std::uniform_real_distribution<double> u(-1, 1);
-    for (int i = 0; i < kObjects; ++i) {
-      const Vec3 t(0.8 * u(rng), 0.6 * u(rng), 2.5 + u(rng));
-      const Vec3 axis = Vec3(u(rng), u(rng), u(rng)).normalized();
-      Vec6 d;
-      d << Vec3::Constant(std::pow(0.002 + 0.004 * (u(rng) + 1), 2)),
-          Vec3::Constant(std::pow((1 + 2 * (u(rng) + 1)) * 3.14159 / 180, 2));
-      f.poses.push_back({pose_from(t, Eigen::Quaterniond(Eigen::AngleAxisd(3 * u(rng), axis))),
-                         d.asDiagonal(), false});
-      std::vector<Vec3> box;
-      const double s = 0.1 + 0.05 * u(rng);
-      for (int k = 0; k < 8; ++k)
-        box.emplace_back(k & 1 ? s : -s, k & 2 ? 0.7 * s : -0.7 * s, k & 4 ? 0.5 * s : -0.5 * s);
-      f.vertices.push_back(box);
-      f.regions.push_back(compute_object_regions(f.camera, f.poses.back(), box));
-    }
+    Frame f{test::make_bench_frame(kObjects), {}};
+    for (int i = 0; i < kObjects; ++i)
+      f.regions.push_back(compute_object_regions(f.camera, f.poses[i], f.vertices[i]));
     return f;
   }();
   return f;
