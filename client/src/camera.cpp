@@ -1,5 +1,7 @@
 #include "covtrack/client/camera.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
 
@@ -76,7 +78,9 @@ Result<int> read_positive_int(const cv::FileStorage& fs, const std::string& file
 
 Result<Camera> load_camera(const std::filesystem::path& path) {
   const std::string file = path.string();
-  if (!std::filesystem::exists(path)) return fail(fmt::format("{}: no such file", file));
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    return fail(fmt::format("{}: calibration file not found", file));
   cv::FileStorage fs;
   try {
     // OpenCV throws on a malformed file; turn that into an error value.
@@ -100,7 +104,8 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
   const auto k = [&](int i) { return K->at<double>(i); };
   cam.fx = k(0), cam.cx = k(2), cam.fy = k(4), cam.cy = k(5);
   if (!(cam.fx > 0 && cam.fy > 0) || k(1) != 0 || k(3) != 0 || k(6) != 0 || k(7) != 0 ||
-      k(8) != 1)
+      k(8) != 1 || !std::isfinite(cam.fx) || !std::isfinite(cam.fy) || !std::isfinite(cam.cx) ||
+      !std::isfinite(cam.cy))
     return fail(fmt::format(
         "{}: key 'camera_matrix' is not a pinhole matrix [fx 0 cx; 0 fy cy; 0 0 1]", file));
 
@@ -110,6 +115,9 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
   if (n < 4)
     return fail(fmt::format("{}: key 'distortion_coefficients' needs 4 or 5 values, has {}",
                             file, n));
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(dist->at<double>(i)))
+      return fail(fmt::format("{}: key 'distortion_coefficients': coefficient {} is not finite", file, i));
   for (int i = 5; i < n; ++i)
     if (dist->at<double>(i) != 0)
       return fail(fmt::format(

@@ -2,7 +2,6 @@
 // tests/netns_run.sh): covtrackd publishing over real UDP multicast, a subscriber here.
 #include <gtest/gtest.h>
 
-#include <poll.h>
 
 #include <chrono>
 #include <cmath>
@@ -43,10 +42,7 @@ class Collector {
   bool good() { return lcm_.good(); }
 
   void run_for(double seconds) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    pollfd pfd{lcm_.getFileno(), POLLIN, 0};
-    while (std::chrono::steady_clock::now() < end)
-      if (poll(&pfd, 1, 20) > 0) lcm_.handle();
+    covtrack::test::handle_for(lcm_, seconds);
   }
 
   std::map<std::string, StreamLog> poses;

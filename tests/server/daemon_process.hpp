@@ -1,5 +1,6 @@
 #pragma once
 // Starts covtrackd as a separate process for end-to-end tests, and stops it with a signal.
+#include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -8,6 +9,8 @@
 #include <fstream>
 #include <string>
 #include <thread>
+
+#include <lcm/lcm-cpp.hpp>
 
 namespace covtrack::test {
 
@@ -51,5 +54,14 @@ class DaemonProcess {
   pid_t pid_ = -1;
   bool exited_ = false;
 };
+
+// Handles every message `lcm` receives for `seconds` (polling in 20 ms slices, so the
+// loop ends on time even when nothing arrives).
+inline void handle_for(lcm::LCM& lcm, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  pollfd pfd{lcm.getFileno(), POLLIN, 0};
+  while (std::chrono::steady_clock::now() < end)
+    if (poll(&pfd, 1, 20) > 0) lcm.handle();
+}
 
 }  // namespace covtrack::test

@@ -3,7 +3,6 @@
 // process, inside a private network namespace).
 #include <gtest/gtest.h>
 
-#include <poll.h>
 
 #include <chrono>
 #include <map>
@@ -26,10 +25,7 @@ class Collector {
     lcm_.subscribe("covtrack/status/.*", &Collector::on_status, this)->setQueueCapacity(1000);
   }
   void run_for(double seconds) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    pollfd pfd{lcm_.getFileno(), POLLIN, 0};
-    while (std::chrono::steady_clock::now() < end)
-      if (poll(&pfd, 1, 20) > 0) lcm_.handle();
+    covtrack::test::handle_for(lcm_, seconds);
   }
   std::map<std::string, int> poses;
   std::map<std::string, device_status_t> status;

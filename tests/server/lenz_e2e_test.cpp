@@ -4,7 +4,6 @@
 // pseudo-terminal closes) and started again.
 #include <gtest/gtest.h>
 
-#include <poll.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -82,10 +81,7 @@ class Collector {
   }
   bool good() { return lcm_.good(); }
   void run_for(double seconds) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    pollfd pfd{lcm_.getFileno(), POLLIN, 0};
-    while (std::chrono::steady_clock::now() < end)
-      if (poll(&pfd, 1, 20) > 0) lcm_.handle();
+    covtrack::test::handle_for(lcm_, seconds);
   }
 
   std::map<std::string, std::vector<Sample>> poses;          // by sensor key device/sensor

@@ -4,7 +4,6 @@
 // that goes away mid-run.
 #include <gtest/gtest.h>
 
-#include <poll.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -42,10 +41,7 @@ class Collector {
   }
   bool good() { return lcm_.good(); }
   void run_for(double seconds) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    pollfd pfd{lcm_.getFileno(), POLLIN, 0};
-    while (std::chrono::steady_clock::now() < end)
-      if (poll(&pfd, 1, 20) > 0) lcm_.handle();
+    covtrack::test::handle_for(lcm_, seconds);
   }
   std::map<std::string, std::vector<pose_cov_t>> poses;  // by "device/sensor"
   std::map<std::string, device_status_t> status;

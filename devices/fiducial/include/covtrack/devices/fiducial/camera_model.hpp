@@ -1,7 +1,6 @@
 #pragma once
-// The camera intrinsics the fiducial tracker needs, read from the calibration file
-// OpenCV's calibration sample writes (the same layout as the client's camera files:
-// image_width, image_height, camera_matrix, distortion_coefficients).
+// The camera intrinsics the fiducial tracker needs, in OpenCV's form (K, distortion
+// vector), read by the client's calibration reader (client/camera.hpp).
 // Camera frame as in OpenCV: +z forward, x right, y down; pixel centres at integers.
 #include <filesystem>
 
