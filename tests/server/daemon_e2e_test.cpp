@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <random>
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -28,7 +29,7 @@ std::string url_for(int port) {
 
 struct StreamLog {
   std::int64_t received = 0, gaps = 0, last_sequence = -1;
-  std::int64_t max_interval_us = 0, last_receive_us = 0;
+  std::int64_t max_interval_us = 0, first_receive_us = 0, last_receive_us = 0;
   std::map<std::int64_t, pose_cov_t> by_time;  // for pairing with the truth
 };
 
@@ -61,6 +62,7 @@ class Collector {
       s.gaps += m->sequence - s.last_sequence - 1;
     const std::int64_t t = now();
     if (s.last_receive_us) s.max_interval_us = std::max(s.max_interval_us, t - s.last_receive_us);
+    if (!s.first_receive_us) s.first_receive_us = t;
     s.last_receive_us = t;
     s.last_sequence = m->sequence;
     ++s.received;
@@ -115,7 +117,11 @@ TEST(DaemonEndToEnd, NeesAgainstTheTruthChannelIsChiSquare6) {
   const std::string url = url_for(7702);
   Collector c(url);
   c.keep_samples = true;
-  test::DaemonProcess daemon(sim_device("rig", 4, 500), url);
+  // A fresh noise seed per run: with the default seed every run would test the same
+  // draws, and a seed whose first draws sit near the bound would fail every time.
+  const std::uint64_t seed = std::random_device{}() % 1000000;
+  test::DaemonProcess daemon(sim_device("rig", 4, 1000, "seed = " + std::to_string(seed) + "\n"),
+                             url);
   c.run_for(2.5);
 
   Mat6 cov = Mat6::Zero();
@@ -135,9 +141,11 @@ TEST(DaemonEndToEnd, NeesAgainstTheTruthChannelIsChiSquare6) {
       ++n;
     }
   }
-  ASSERT_GE(n, 2000);
+  ASSERT_GE(n, 4000);
+  // NEES of n independent pairs: mean 6, variance 12/n. Two-sided 99.9% bound, so an
+  // honest covariance fails one run in a thousand; a covariance 5% off fails nearly always.
   const double mean = sum / n;
-  EXPECT_NEAR(mean, 6.0, 2.576 * std::sqrt(12.0 / n)) << "over " << n << " pairs";
+  EXPECT_NEAR(mean, 6.0, 3.29 * std::sqrt(12.0 / n)) << "over " << n << " pairs, seed " << seed;
 }
 
 TEST(DaemonEndToEnd, FailingDeviceRestartsWhileTheOtherKeepsPublishing) {
@@ -151,7 +159,11 @@ TEST(DaemonEndToEnd, FailingDeviceRestartsWhileTheOtherKeepsPublishing) {
   c.run_for(3.0);
 
   const auto& steady = c.poses["covtrack/pose/steady/s0"];
-  EXPECT_GT(steady.received, 450);
+  // The rate over the span it was received, not a count in a fixed window: a slow
+  // start-up on a loaded machine shortens the window without meaning a stall.
+  const double span_s = (steady.last_receive_us - steady.first_receive_us) * 1e-6;
+  EXPECT_GT(span_s, 1.5);
+  EXPECT_GT(steady.received, 0.95 * 200 * span_s) << "over " << span_s << " s";
   EXPECT_EQ(steady.gaps, 0);
   EXPECT_LT(steady.max_interval_us, 50000) << "the steady device stalled";
   ASSERT_TRUE(c.status.count("flaky"));

@@ -56,3 +56,59 @@ TEST(Scene, SchemaDocumentIsUpToDate) {
   EXPECT_EQ(text.str(), covtrack::scene::scene_schema_markdown())
       << "regenerate it: covtrack regions --print-schema > config/scene_schema.md";
 }
+
+namespace {
+const std::string kCamera = "[camera]\nframe = \"c\"\ncalibration = \"c.yml\"\n";
+const std::string kTracked =
+    "[[transform]]\nparent = \"c\"\nchild = \"t\"\nposition_m = [1, 0, 0]\nsigma_m = [0.1, 0.1, 0.1]\n"
+    "sigma_rad = [0.1, 0.1, 0.1]\nstream = \"dev/s0\"\n";
+}  // namespace
+
+TEST(Scene, KeyframesInterpolateAndRepeat) {
+  const std::string text = kCamera + kTracked +
+                           "[[transform.keyframe]]\nt_s = 0\n"
+                           "[[transform.keyframe]]\nt_s = 2\nposition_m = [3, 0, 0]\nsigma_scale = 5\n"
+                           "[[transform.keyframe]]\nt_s = 4\n";
+  auto s = parse_scene(text, "k.toml", ".");
+  ASSERT_TRUE(s) << s.error().message;
+  const covtrack::scene::SceneTransform& t = s->transforms[0];
+  ASSERT_EQ(t.keyframes.size(), 3u);
+  EXPECT_EQ(t.keyframes[0].position_m.x(), 1);  // the transform's own position
+  const auto at = [&](double time_s) { return covtrack::scene::scripted_value(t, time_s); };
+  EXPECT_NEAR(at(1).T_parent_child.translation().x(), 2, 1e-12);
+  EXPECT_NEAR(std::sqrt(at(1).covariance(0, 0)), 0.1 * 3, 1e-12);  // sigma scale 1 -> 5, halfway
+  EXPECT_NEAR(at(2).T_parent_child.translation().x(), 3, 1e-12);
+  EXPECT_NEAR(std::sqrt(at(3).covariance(5, 5)), 0.1 * 3, 1e-12);
+  // The last keyframe's time is the period.
+  EXPECT_NEAR(at(5).T_parent_child.translation().x(), at(1).T_parent_child.translation().x(), 1e-12);
+  EXPECT_NEAR(at(4).T_parent_child.translation().x(), 1, 1e-12);
+  EXPECT_NEAR(at(-1).T_parent_child.translation().x(), at(3).T_parent_child.translation().x(), 1e-12);
+}
+
+TEST(Scene, WidgetKeysAndTheirMistakes) {
+  const std::string object = "[[object]]\nname = \"o\"\nframe = \"t\"\nbox_m = [1, 1, 1]\n";
+  auto s = parse_scene(kCamera + kTracked + object +
+                           "level_of_error_px = [4, 9]\naugmentations = [\"outline\", \"region\", \"label\"]\n"
+                           "[pointer]\nframe = \"t\"\ntip_m = [0, 0, 0.1]\nlikelihood = \"distance\"\n",
+                       "w.toml", ".");
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_EQ(s->objects[0].augmentations.back(), covtrack::scene::Augmentation::label);
+  ASSERT_TRUE(s->pointer);
+  EXPECT_EQ(s->pointer->likelihood, covtrack::scene::Likelihood::distance);
+  EXPECT_EQ(s->pointer->tip_m.z(), 0.1);
+
+  expect_has(error_of(kCamera + object + "level_of_error_px = [4, 9]\n"),
+             "object[0].augmentations: 2 thresholds need 3 augmentations, found 1");
+  expect_has(error_of(kCamera + object + "level_of_error_px = [9, 4]\naugmentations = [\"outline\", \"region\", \"label\"]\n"),
+             "object[0].level_of_error_px: thresholds must be strictly ascending");
+  expect_has(error_of(kCamera + object + "level_of_error_px = [4]\naugmentations = [\"outline\", \"arrow\"]\n"),
+             "object[0].augmentations: 'arrow' is not outline, region or label");
+  expect_has(error_of(kCamera + "[pointer]\nframe = \"t\"\nlikelihood = \"luck\"\n"), "pointer.likelihood");
+  expect_has(error_of(kCamera + "[[transform]]\nparent = \"c\"\nchild = \"t\"\nsigma_m = [1,1,1]\nsigma_rad = [1,1,1]\n"
+                      "[[transform.keyframe]]\nt_s = 0\n"),
+             "transform[0].keyframe: keyframes script a tracker's reports: the transform needs a stream");
+  expect_has(error_of(kCamera + kTracked + "[[transform.keyframe]]\nt_s = 1\n"),
+             "transform[0].keyframe[0].t_s: the first keyframe is at 0");
+  expect_has(error_of(kCamera + kTracked + "[[transform.keyframe]]\nt_s = 0\n[[transform.keyframe]]\nt_s = 0\n"),
+             "transform[0].keyframe[1].t_s: keyframes must be in ascending time");
+}

@@ -1,7 +1,9 @@
 // `covtrack view` as a user runs it: headless pictures checked pixel by pixel against the
 // regions `covtrack regions --json` reports, a video, a broken background, no display, and
 // live streams (published by this test inside its private network namespace).
+#include <algorithm>
 #include <array>
+#include <cstdlib>
 #include <atomic>
 #include <cstdio>
 #include <filesystem>
@@ -117,6 +119,36 @@ TEST(ViewCli, PictureShowsInnerRegionsInsideOuterRegions) {
   EXPECT_GT(c.green, 500);
   EXPECT_GT(c.white, 300);
   EXPECT_EQ(c.white_astray, 0);
+  std::filesystem::remove(png);
+}
+
+// The tool-box demo 4.5 s into its loop (shaded regions, leader lines, the pointer between
+// drawers with its targets), against a reviewed picture. Offline frames are rendered at
+// their scene times, so the picture is the same on every run; the tolerance covers
+// anti-aliasing differences, not a moved region or label.
+// To accept a deliberate change: COVTRACK_UPDATE_GOLDEN=1 build/tests/tools/view_cli_test
+TEST(ViewCli, ToolBoxFrameMatchesTheGoldenImage) {
+  const std::string golden = COVTRACK_SOURCE_DIR "/tests/tools/golden/toolbox_4.5s.png";
+  const std::string png = (kTmp / "covtrack_view_toolbox.png").string();
+  const CliRun view = run("view " COVTRACK_SOURCE_DIR "/config/scenes/toolbox.toml --png " + png + " --duration 4.5");
+  ASSERT_EQ(view.exit_code, 0) << view.out;
+  const cv::Mat image = cv::imread(png, cv::IMREAD_COLOR);
+  ASSERT_FALSE(image.empty());
+  if (std::getenv("COVTRACK_UPDATE_GOLDEN")) std::filesystem::copy_file(png, golden, std::filesystem::copy_options::overwrite_existing);
+  const cv::Mat expected = cv::imread(golden, cv::IMREAD_COLOR);
+  ASSERT_FALSE(expected.empty()) << golden;
+  ASSERT_EQ(image.size(), expected.size());
+  cv::Mat difference;
+  cv::absdiff(image, expected, difference);
+  int differing = 0;
+  for (int y = 0; y < difference.rows; ++y)
+    for (int x = 0; x < difference.cols; ++x) {
+      const cv::Vec3b d = difference.at<cv::Vec3b>(y, x);
+      differing += std::max({d[0], d[1], d[2]}) > 48;
+    }
+  const double fraction = double(differing) / (image.rows * image.cols);
+  std::printf("golden: %d pixels (%.3f%%) differ by more than 48 levels\n", differing, 100 * fraction);
+  EXPECT_LT(fraction, 0.002);
   std::filesystem::remove(png);
 }
 

@@ -1,11 +1,13 @@
 #include "region_drawing.hpp"
 
+#include <algorithm>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <fmt/format.h>
 
-#include "covtrack/client/label_placer.hpp"
+#include "view_labels.hpp"
 
 namespace covtrack::cli {
 namespace {
@@ -18,11 +20,10 @@ constexpr double kScale = 1 << kShift;
 // picture can be checked pixel by pixel; labels are yellow, the legend's text light grey.
 const cv::Scalar kBlue(255, 120, 0), kGreen(0, 200, 0), kWhite(255, 255, 255),
     kGrey(160, 160, 160), kRed(0, 0, 255), kYellow(0, 230, 230), kLegend(210, 210, 210),
-    kPanel(30, 30, 30);
+    kPanel(30, 30, 30), kCyan(230, 200, 0), kMagenta(230, 0, 230);
 
-const int kFont = cv::FONT_HERSHEY_SIMPLEX;
-constexpr double kFontScale = 0.45;
-constexpr int kLabelPad = 2;
+const int kFont = kLabelFont;
+constexpr double kFontScale = kLabelFontScale;
 
 cv::Point fixed_point(const client::Vec2& p) {
   return {cvRound(p.x() * kScale), cvRound(p.y() * kScale)};
@@ -38,44 +39,107 @@ void draw_polygon(cv::Mat& image, const client::Polygon& polygon, const cv::Scal
 
 }  // namespace
 
-void draw_regions(cv::Mat& image, const RegionsReport& report) {
+cv::Scalar likelihood_colour(double likelihood) {
+  const double p = std::clamp(likelihood, 0.0, 1.0);
+  return cv::Scalar(0, 255 * (1 - p), 255);
+}
+
+namespace {
+
+// Translucent fills go under every line, so outlines keep their pure colours.
+void fill_polygon(cv::Mat& image, const client::Polygon& polygon, const cv::Scalar& colour, double alpha) {
+  if (polygon.size() < 3) return;
+  std::vector<cv::Point> points;
+  for (const client::Vec2& p : polygon) {
+    if (!p.allFinite()) return;
+    points.push_back(fixed_point(p));
+  }
+  // Blend only the polygon's bounding box: a whole-frame copy per object costs more.
+  cv::Rect bounds = cv::boundingRect(points);
+  bounds = cv::Rect(bounds.x >> kShift, bounds.y >> kShift, (bounds.width >> kShift) + 2, (bounds.height >> kShift) + 2) &
+           cv::Rect(0, 0, image.cols, image.rows);
+  if (bounds.empty()) return;
+  for (cv::Point& p : points) p -= cv::Point(bounds.x << kShift, bounds.y << kShift);
+  cv::Mat roi = image(bounds);
+  cv::Mat layer = roi.clone();
+  cv::fillConvexPoly(layer, points, colour, cv::LINE_AA, kShift);
+  cv::addWeighted(layer, alpha, roi, 1 - alpha, 0, roi);
+}
+
+client::Polygon outline_of(const client::ObjectRegions& r) {
+  client::Polygon outline;
+  for (int i : r.hull) outline.push_back(r.vertices[i].mean_px);
+  return outline;
+}
+
+void draw_vertex_ellipses(cv::Mat& image, const client::ObjectRegions& r, double scale) {
+  for (const client::ProjectedVertex& v : r.vertices) {
+    if (!v.flags.usable()) continue;
+    const int sides = client::circumscribed_polygon_sides(
+        scale * client::ellipse_axes(v.covariance_px2).major_px, 0.5, 16, 256);
+    draw_polygon(image, client::circumscribed_ellipse_polygon(v.mean_px, v.covariance_px2, scale, sides), kBlue);
+    cv::circle(image, fixed_point(v.mean_px), 2 * kScale, kGrey, cv::FILLED, cv::LINE_AA, kShift);
+  }
+}
+
+void draw_box(cv::Mat& image, const client::Box& b, const std::string& text, const cv::Scalar& colour) {
+  const cv::Rect box(cvRound(b.min.x()), cvRound(b.min.y()), cvRound(b.width()), cvRound(b.height()));
+  cv::rectangle(image, box, kPanel, cv::FILLED);
+  cv::putText(image, text, cv::Point(box.x + kLabelPad, box.y + box.height - kLabelPad - 3), kFont, kFontScale,
+              colour, 1, cv::LINE_AA);
+}
+
+void draw_pointer(cv::Mat& image, const WidgetFrame& w) {
+  const client::Pointer& pointer = *w.pointer;
+  if (pointer.lost) return;
+  draw_polygon(image, pointer.region, kMagenta, 1);
+  const cv::Point tip = fixed_point(pointer.position_px);
+  const int arm = 6 * kScale;
+  cv::line(image, tip - cv::Point(arm, 0), tip + cv::Point(arm, 0), kMagenta, 1, cv::LINE_AA, kShift);
+  cv::line(image, tip - cv::Point(0, arm), tip + cv::Point(0, arm), kMagenta, 1, cv::LINE_AA, kShift);
+}
+
+}  // namespace
+
+void draw_regions(cv::Mat& image, const RegionsReport& report, const WidgetFrame* widgets) {
   const double scale = client::confidence_scale(report.confidence);
-  std::vector<client::LabelRequest> labels;
-  std::vector<std::string> texts;
-  for (const RegionsReport::Object& o : report.objects) {
-    const client::ObjectRegions& r = o.regions;
-    client::Polygon outline;
-    for (int i : r.hull) outline.push_back(r.vertices[i].mean_px);
-    draw_polygon(image, outline, kGrey);
-    for (const client::ProjectedVertex& v : r.vertices) {
-      if (!v.flags.usable()) continue;
-      const int sides = client::circumscribed_polygon_sides(
-          scale * client::ellipse_axes(v.covariance_px2).major_px, 0.5, 16, 256);
-      draw_polygon(image, client::circumscribed_ellipse_polygon(v.mean_px, v.covariance_px2, scale, sides), kBlue);
-      cv::circle(image, fixed_point(v.mean_px), 2 * kScale, kGrey, cv::FILLED, cv::LINE_AA, kShift);
-    }
+  const auto augmentation = [&](std::size_t i) {
+    return widgets ? widgets->augmentations[i] : scene::Augmentation::outline;
+  };
+  const bool selecting = widgets && widgets->pointer;
+  for (std::size_t i = 0; i < report.objects.size(); ++i) {
+    const client::ObjectRegions& r = report.objects[i].regions;
+    // Seed figure 19: the outer regions filled by likelihood; otherwise the Level-of-Error
+    // "region" augmentation shades where the object can be.
+    if (selecting) fill_polygon(image, r.outer, likelihood_colour(widgets->likelihoods[i]), 0.35);
+    else if (augmentation(i) == scene::Augmentation::region) fill_polygon(image, r.outer, kCyan, 0.3);
+  }
+
+  for (std::size_t i = 0; i < report.objects.size(); ++i) {
+    const client::ObjectRegions& r = report.objects[i].regions;
+    const bool selected = selecting && widgets->selection.selected == static_cast<int>(i);
+    const bool bold = widgets && augmentation(i) == scene::Augmentation::outline;
+    draw_polygon(image, outline_of(r), selected ? kRed : bold ? kCyan : kGrey, selected || bold ? 2 : 1);
+    draw_vertex_ellipses(image, r, scale);
     draw_polygon(image, r.outer, kGreen, 2);
     draw_polygon(image, r.inner, kWhite, 2);
-    texts.push_back(r.valid ? fmt::format("{} {:.1f} px", o.name, r.assessment) : fmt::format("{}: no region", o.name));
-    int baseline = 0;
-    const cv::Size text = cv::getTextSize(texts.back(), kFont, kFontScale, 1, &baseline);
-    labels.push_back({r.inner, r.outer, client::Vec2(text.width + 2 * kLabelPad, text.height + baseline + 2 * kLabelPad)});
   }
-  // Labels by the seed's placer (5.6.3): inside the inner region when they fit, else
-  // outside the outer region with a leader line, else listed in the top-left corner.
-  client::LabelPlacerOptions options;
-  options.screen = {client::Vec2(0, 0), client::Vec2(image.cols, image.rows)};
-  const std::vector<client::PlacedLabel> placed = client::place_labels(labels, options);
-  for (std::size_t i = 0; i < placed.size(); ++i) {
-    const client::PlacedLabel& p = placed[i];
-    const bool valid = report.objects[i].regions.valid;
+  if (selecting) draw_pointer(image, *widgets);
+
+  const ViewLabels labels = layout_labels(report, widgets, image.size());
+  for (std::size_t i = 0; i < labels.placed.size(); ++i) {
+    const client::PlacedLabel& p = labels.placed[i];
     if (p.leader)
       cv::line(image, fixed_point((*p.leader)[0]), fixed_point((*p.leader)[1]), kYellow, 1, cv::LINE_AA, kShift);
-    const cv::Rect box(cvRound(p.box.min.x()), cvRound(p.box.min.y()), cvRound(p.box.width()), cvRound(p.box.height()));
-    cv::rectangle(image, box, kPanel, cv::FILLED);
-    cv::putText(image, texts[i], cv::Point(box.x + kLabelPad, box.y + box.height - kLabelPad - 3), kFont,
-                kFontScale, valid ? kYellow : kRed, 1, cv::LINE_AA);
+    draw_box(image, p.box, labels.texts[i], report.objects[i].regions.valid ? kYellow : kRed);
   }
+  // Indirect selection: one target per candidate, spaced by the pointer's error.
+  if (widgets)
+    for (const client::SelectionTarget& t : widgets->targets) {
+      draw_box(image, t.box, report.objects[static_cast<std::size_t>(t.object)].name, kMagenta);
+      const cv::Rect r(cvRound(t.box.min.x()), cvRound(t.box.min.y()), cvRound(t.box.width()), cvRound(t.box.height()));
+      cv::rectangle(image, r, kMagenta, 1);
+    }
 }
 
 void draw_legend(cv::Mat& image, const std::vector<std::string>& lines) {

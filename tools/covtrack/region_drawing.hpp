@@ -3,7 +3,12 @@
 // regions green, inner regions white; the object's outline (the hull of its projected
 // vertices) grey; labels (yellow) placed by the seed's label placer; a legend in the
 // bottom-left corner. Used by `covtrack regions --png` and
-// `covtrack view`.
+// `covtrack view`. With the view's widgets: each object's Level-of-Error augmentation
+// (outline: its outline bold cyan; region: its outer region shaded cyan; label: its
+// label listed, not anchored); with a pointer, the outer regions filled by selection
+// likelihood from yellow (0) to red (1) (seed figure 19) instead of the cyan shade, the
+// selected object outlined red, the pointer's region magenta, and the indirect targets
+// when the selection is ambiguous.
 #include <string>
 #include <vector>
 
@@ -11,11 +16,15 @@
 
 #include "covtrack/protocol/result.hpp"
 #include "regions_report.hpp"
+#include "view_widgets.hpp"
 
 namespace covtrack::cli {
 
 // `image` must be 8-bit BGR; drawn on in place.
-void draw_regions(cv::Mat& image, const RegionsReport& report);
+void draw_regions(cv::Mat& image, const RegionsReport& report, const WidgetFrame* widgets = nullptr);
+
+// The selection likelihood's colour (BGR): yellow at 0 to red at 1.
+cv::Scalar likelihood_colour(double likelihood);
 void draw_legend(cv::Mat& image, const std::vector<std::string>& lines);
 
 Result<void> write_png(const cv::Mat& image, const std::string& path);

@@ -28,6 +28,11 @@ Result<RegionsReport> compute_regions(const RegionsModel& model, const client::T
     report.objects.push_back({o.name, o.frame, o.hull_vertices_m,
                               client::compute_object_regions(model.camera, *T, o.hull_vertices_m, options)});
   }
+  if (const auto& pointer = model.scene.pointer) {
+    const auto T = graph.query(report.camera_frame, pointer->frame, time_us);
+    if (!T) return fail(fmt::format("pointer: {}", T.error().message));
+    report.pointer_tip = client::project_vertex(model.camera, *T, pointer->tip_m, options.projection);
+  }
   return report;
 }
 

@@ -3,6 +3,7 @@
 // `covtrack view` draws. The scene is loaded once (RegionsModel); regions are computed
 // per frame from a transform graph at a time.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,8 @@ struct RegionsReport {
   std::string camera_frame;
   double confidence = 0.95;
   std::vector<Object> objects;
+  // The scene's pointer tip on the screen, with its error (when the scene has a pointer).
+  std::optional<client::ProjectedVertex> pointer_tip;
 };
 
 // The regions of every object at time_us. Fails naming the object (not the file) if its

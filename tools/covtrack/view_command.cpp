@@ -25,6 +25,7 @@
 #include "stop_signal.hpp"
 #include "view_background.hpp"
 #include "view_log.hpp"
+#include "view_widgets.hpp"
 
 namespace covtrack::cli {
 namespace {
@@ -64,6 +65,19 @@ std::vector<std::string> legend_lines(const RegionsModel& model, const LatestRep
   return lines;
 }
 
+// What the pointer does now, for the legend.
+std::string selection_line(const RegionsReport& report, const WidgetFrame& w) {
+  if (!w.pointer) return {};
+  if (w.pointer->lost) return "pointer: no usable position, selects nothing";
+  const auto& s = w.selection;
+  const std::string head = "pointer (fill: yellow p=0 to red p=1): ";
+  if (!s.selected) return head + "selects nothing";
+  const std::string name = fmt::format("{} (p={:.2f})", report.objects[static_cast<std::size_t>(*s.selected)].name,
+                                       w.likelihoods[static_cast<std::size_t>(*s.selected)]);
+  if (!s.ambiguous()) return head + fmt::format("selects {}", name);
+  return head + fmt::format("{} candidates, best {}: pick a target", s.candidates.size(), name);
+}
+
 int run_view(const ViewArgs& args) {
   const auto fail_with = [](const std::string& message, int code) {
     std::cerr << "covtrack view: " << message << "\n";
@@ -74,6 +88,8 @@ int run_view(const ViewArgs& args) {
     return fail_with("no display (DISPLAY is not set): use --png FILE or --video FILE", 2);
   const auto model = load_regions_model(args.scene_path, args.confidence);
   if (!model) return fail_with(model.error().message, 2);
+  auto widgets = ViewWidgets::create(model->scene);
+  if (!widgets) return fail_with(fmt::format("{}: {}", args.scene_path, widgets.error().message), 2);
 
   if (args.live && !args.log_path.empty()) return fail_with("--live and --log exclude each other", 2);
   client::TransformGraph graph;
@@ -112,33 +128,45 @@ int run_view(const ViewArgs& args) {
 
   install_stop_signals();
   const double duration_s = args.duration_s > 0 ? args.duration_s : (video ? 10.0 : 0.0);
+  // Offline into a file, nothing outside sets the pace: frames are rendered at their
+  // scene times as fast as they can be, and the same command gives the same pictures.
+  const bool virtual_clock = fixed && !window;
   const auto start = std::chrono::steady_clock::now();
   const auto period = std::chrono::duration<double>(1.0 / args.fps);
   for (long frame_index = 0;; ++frame_index) {
-    const auto due = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(frame_index * period);
-    std::this_thread::sleep_until(due);
-    const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    double elapsed_s = frame_index * period.count();
+    if (!virtual_clock) {
+      std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(frame_index * period));
+      elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
     // The log's clock runs at --speed from its first event.
     const std::optional<std::int64_t> log_time =
         log ? std::optional<std::int64_t>(log->start_us() + std::llround(elapsed_s * args.speed * 1e6))
             : std::nullopt;
     if (log) log->advance_to(*log_time, graph);
-    const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s) ||
+    const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s - 1e-9) ||
                       (log && log->finished());
+    // Fixed scene values are as fresh as when they were set: no staleness grows on them.
+    const std::int64_t now = log_time ? *log_time : fixed_at.value_or(covtrack::now_us());
+    if (fixed)
+      if (auto r = scene::report_keyframes(model->scene, graph, elapsed_s, now); !r)
+        return fail_with(fmt::format("{}: {}", args.scene_path, r.error().message), 2);
+    const auto report = compute_regions(*model, graph, now, args.method);
+    if (!report) return fail_with(fmt::format("{}: {}", args.scene_path, report.error().message), 2);
+    // Every frame feeds the Level-of-Error hysteresis, even those --png does not write.
+    const WidgetFrame widget_frame = widgets->update(*report, size);
     // --png takes its one frame at the end of --duration (live streams have arrived by then).
     if (!args.png_path.empty() && !last && duration_s > 0) continue;
 
-    // Fixed scene values are as fresh as when they were set: no staleness grows on them.
-    const std::int64_t now = log_time ? *log_time : fixed_at.value_or(covtrack::now_us());
-    const auto report = compute_regions(*model, graph, now, args.method);
-    if (!report) return fail_with(fmt::format("{}: {}", args.scene_path, report.error().message), 2);
     cv::Mat image = background.next(warning);
     if (!warning.empty()) {
       std::cerr << "covtrack view: " << warning << "\n";
       warning.clear();
     }
-    draw_regions(image, *report);
-    draw_legend(image, legend_lines(*model, latest_report, now));
+    draw_regions(image, *report, &widget_frame);
+    auto lines = legend_lines(*model, latest_report, now);
+    if (const std::string line = selection_line(*report, widget_frame); !line.empty()) lines.push_back(line);
+    draw_legend(image, lines);
 
     if (!args.png_path.empty()) {
       if (auto r = write_png(image, args.png_path); !r) return fail_with(r.error().message, 1);
@@ -169,7 +197,9 @@ void add_view_command(CLI::App& app) {
   cmd->add_option("--video", args->video_path, "Write the frames to this video file (MJPG AVI)");
   cmd->add_option("--background", args->background,
                   "#rrggbb, an image file, a video file (looped) or camera:N");
-  cmd->add_option("--duration", args->duration_s, "Seconds to run (default: until q/Esc/Ctrl-C; 10 for --video)")
+  cmd->add_option("--duration", args->duration_s,
+                  "Seconds to run (default: until q/Esc/Ctrl-C; 10 for --video); offline (no --live, no --log) "
+                  "into a file, scene seconds rendered without waiting")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--fps", args->fps, "Frames per second")->capture_default_str()->check(CLI::Range(0.1, 240.0));
   cmd->add_option("--confidence", args->confidence, "Confidence of the regions (default: the scene's)")

@@ -6,6 +6,20 @@
 
 namespace covtrack::scene {
 
+namespace {
+client::TrackedTransform report_of(const SceneTransform& t, std::int64_t measured_us) {
+  client::TrackedTransform report;
+  report.stream = *t.stream;
+  report.parent_frame = t.parent;
+  report.child_frame = t.child;
+  report.T_parent_child = t.T_parent_child;
+  report.covariance = t.covariance;
+  report.status = TrackingStatus::Ok;
+  report.measurement_time_us = report.publish_time_us = report.receive_time_us = measured_us;
+  return report;
+}
+}  // namespace
+
 Result<void> add_scene_transforms(const Scene& scene, client::TransformGraph& graph,
                                   std::optional<std::int64_t> reports_at_us) {
   for (const SceneTransform& t : scene.transforms) {
@@ -21,15 +35,18 @@ Result<void> add_scene_transforms(const Scene& scene, client::TransformGraph& gr
     if (auto r = graph.add_tracked_edge(t.parent, t.child, *t.stream, motion); !r)
       return where(r.error());
     if (!reports_at_us) continue;
-    client::TrackedTransform report;
-    report.stream = *t.stream;
-    report.parent_frame = t.parent;
-    report.child_frame = t.child;
-    report.T_parent_child = t.T_parent_child;
-    report.covariance = t.covariance;
-    report.status = TrackingStatus::Ok;
-    report.measurement_time_us = report.publish_time_us = report.receive_time_us = *reports_at_us;
-    if (auto r = graph.update(t.child, report); !r) return where(r.error());
+    if (auto r = graph.update(t.child, report_of(scripted_value(t, 0), *reports_at_us)); !r)
+      return where(r.error());
+  }
+  return {};
+}
+
+Result<void> report_keyframes(const Scene& scene, client::TransformGraph& graph,
+                              double scene_time_s, std::int64_t now_us) {
+  for (const SceneTransform& t : scene.transforms) {
+    if (t.keyframes.empty()) continue;
+    if (auto r = graph.update(t.child, report_of(scripted_value(t, scene_time_s), now_us)); !r)
+      return fail(fmt::format("transform {} -> {}: {}", t.parent, t.child, r.error().message));
   }
   return {};
 }

@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -16,7 +18,9 @@ const TableSpec& top_spec() {
                             {"transform", ValueType::TableArray, "", "[]",
                              "the frame tree: one [[transform]] per edge"},
                             {"object", ValueType::TableArray, "", "[]",
-                             "objects to register: one [[object]] each"}}};
+                             "objects to register: one [[object]] each"},
+                            {"pointer", ValueType::Table, "", "(none)",
+                             "a tracked pointer that selects objects: [pointer]"}}};
   return s;
 }
 
@@ -46,11 +50,35 @@ const TableSpec& transform_spec() {
                  {"max_speed_mps", ValueType::Float, "m/s", "0",
                   "tracked edge: bound on linear speed, grows the covariance with report age", 0, 1e3},
                  {"max_angular_speed_radps", ValueType::Float, "rad/s", "0",
-                  "tracked edge: bound on angular speed", 0, 1e3}}};
+                  "tracked edge: bound on angular speed", 0, 1e3},
+                 {"keyframe", ValueType::TableArray, "", "[]",
+                  "tracked edge, offline: scripted reports, [[transform.keyframe]]"}}};
     const auto cov = covariance_keys();
     t.keys.insert(t.keys.end(), cov.begin(), cov.end());
     return t;
   }();
+  return s;
+}
+
+const TableSpec& keyframe_spec() {
+  static const TableSpec s{
+      "transform[].keyframe[]", "covtrack view (offline)",
+      {{"t_s", ValueType::Float, "s", "",
+        "scene time; the first is 0, then strictly ascending; the last is the loop period", 0, 1e6},
+       {"position_m", ValueType::FloatArray, "m", "the transform's",
+        "child origin in the parent frame at t_s", -1e6, 1e6, 3},
+       {"sigma_scale", ValueType::Float, "", "1",
+        "multiplies the transform's sigmas at t_s (its covariance by the square)", 0, 1e4}}};
+  return s;
+}
+
+const TableSpec& pointer_spec() {
+  static const TableSpec s{
+      "pointer", "covtrack view",
+      {{"frame", ValueType::String, "", "", "the pointer's frame in the tree"},
+       {"tip_m", ValueType::FloatArray, "m", "[0, 0, 0]", "the pointing point in that frame", -1e6, 1e6, 3},
+       {"likelihood", ValueType::String, "", "area",
+        "area (of the pointer's region on the object's) or distance (to its centre)"}}};
   return s;
 }
 
@@ -63,7 +91,13 @@ const TableSpec& object_spec() {
                             {"box_center_m", ValueType::FloatArray, "m", "[0, 0, 0]",
                              "centre of the box in the object's frame", -1e6, 1e6, 3},
                             {"vertices_m", ValueType::FloatArray, "m", "",
-                             "x y z of each vertex, flattened; instead of box_m", -1e6, 1e6}}};
+                             "x y z of each vertex, flattened; instead of box_m", -1e6, 1e6},
+                            {"level_of_error_px", ValueType::FloatArray, "px", "[]",
+                             "ascending assessment thresholds between the augmentations", 0, 1e6},
+                            {"level_of_error_margin_px", ValueType::Float, "px", "1",
+                             "hysteresis: a level is left only this far below its threshold", 0, 1e6},
+                            {"augmentations", ValueType::StringArray, "", "[\"outline\"]",
+                             "one per level: outline, region or label (one more than thresholds)"}}};
   return s;
 }
 
@@ -109,6 +143,19 @@ SceneTransform read_transform(TableReader& r) {
   return t;
 }
 
+void read_keyframes(TableReader& r, SceneTransform& t) {
+  const auto tables = r.tables("keyframe");
+  if (!tables.empty() && !t.stream)
+    r.error("keyframe", "keyframes script a tracker's reports: the transform needs a stream");
+  for (std::size_t i = 0; i < tables.size(); ++i) {
+    TableReader k(*tables[i], r.path(fmt::format("keyframe[{}]", i)), keyframe_spec(), r.file(), r.errors());
+    Keyframe f{k.number("t_s"), k.vec3("position_m", t.T_parent_child.translation()), k.number("sigma_scale", 1)};
+    if (i == 0 && f.t_s != 0) k.error("t_s", "the first keyframe is at 0");
+    if (i > 0 && f.t_s <= t.keyframes.back().t_s) k.error("t_s", "keyframes must be in ascending time");
+    t.keyframes.push_back(f);
+  }
+}
+
 std::vector<Vec3> box(const Vec3& size, const Vec3& center) {
   std::vector<Vec3> out;
   for (int i = 0; i < 8; ++i)
@@ -132,7 +179,33 @@ SceneObject read_object(TableReader& r) {
     else
       for (std::size_t i = 0; i < flat.size(); i += 3) o.vertices_m.emplace_back(flat[i], flat[i + 1], flat[i + 2]);
   }
+  o.level_of_error_px = r.numbers("level_of_error_px");
+  if (!std::is_sorted(o.level_of_error_px.begin(), o.level_of_error_px.end(), std::less_equal<>()))
+    r.error("level_of_error_px", "thresholds must be strictly ascending");
+  o.level_of_error_margin_px = r.number("level_of_error_margin_px", 1);
+  if (r.has("augmentations")) {
+    o.augmentations.clear();
+    for (const std::string& name : r.strings("augmentations")) {
+      if (name == "outline") o.augmentations.push_back(Augmentation::outline);
+      else if (name == "region") o.augmentations.push_back(Augmentation::region);
+      else if (name == "label") o.augmentations.push_back(Augmentation::label);
+      else r.error("augmentations", fmt::format("'{}' is not outline, region or label", name));
+    }
+  }
+  if (o.augmentations.size() != o.level_of_error_px.size() + 1)
+    r.error("augmentations", fmt::format("{} thresholds need {} augmentations, found {}",
+                                         o.level_of_error_px.size(), o.level_of_error_px.size() + 1,
+                                         o.augmentations.size()));
   return o;
+}
+
+ScenePointer read_pointer(TableReader& r) {
+  ScenePointer p;
+  p.frame = r.string("frame");
+  p.tip_m = r.vec3("tip_m");
+  p.likelihood = r.choice("likelihood", {"area", "distance"}, "area") == "distance" ? Likelihood::distance
+                                                                                     : Likelihood::area;
+  return p;
 }
 
 }  // namespace
@@ -155,11 +228,16 @@ Result<Scene> parse_scene(std::string_view text, const std::string& source, cons
   for (std::size_t i = 0; i < transforms.size(); ++i) {
     TableReader r(*transforms[i], fmt::format("transform[{}]", i), transform_spec(), source, errors);
     scene.transforms.push_back(read_transform(r));
+    read_keyframes(r, scene.transforms.back());
   }
   const auto objects = top.tables("object");
   for (std::size_t i = 0; i < objects.size(); ++i) {
     TableReader r(*objects[i], fmt::format("object[{}]", i), object_spec(), source, errors);
     scene.objects.push_back(read_object(r));
+  }
+  if (const toml::table* p = top.table("pointer")) {
+    TableReader r(*p, "pointer", pointer_spec(), source, errors);
+    scene.pointer = read_pointer(r);
   }
   if (!errors.empty()) return fail(errors.joined());
   return scene;
@@ -174,7 +252,17 @@ Result<Scene> load_scene(const std::string& path) {
 std::string scene_schema_markdown() {
   return "# Scene file schema\n\nRead by `covtrack regions SCENE`. Generated by "
          "`covtrack regions --print-schema`; a test keeps this file equal to its output.\n\n" +
-         schema_markdown({&top_spec(), &camera_spec(), &transform_spec(), &object_spec()});
+         schema_markdown({&top_spec(), &camera_spec(), &transform_spec(), &keyframe_spec(),
+                          &object_spec(), &pointer_spec()});
+}
+
+const char* to_string(Augmentation a) {
+  switch (a) {
+    case Augmentation::outline: return "outline";
+    case Augmentation::region: return "region";
+    case Augmentation::label: return "label";
+  }
+  return "?";
 }
 
 }  // namespace covtrack::scene

@@ -12,6 +12,14 @@
 
 namespace covtrack::scene {
 
+// One point of an offline script for a tracked edge: what its tracker reports at time
+// t_s of the scene's clock (values between keyframes are interpolated linearly).
+struct Keyframe {
+  double t_s = 0;
+  Vec3 position_m = Vec3::Zero();  // the edge's position_m unless the keyframe sets it
+  double sigma_scale = 1;          // multiplies the edge's sigmas (covariance by its square)
+};
+
 struct SceneTransform {
   std::string parent;
   std::string child;
@@ -20,12 +28,35 @@ struct SceneTransform {
   std::optional<StreamId> stream;  // tracked edge: bound to this device/sensor stream
   double max_speed_mps = 0;        // tracked edge: motion bound for staleness growth
   double max_angular_speed_radps = 0;
+  // Offline only (no --live, no --log): the reports its tracker would send, repeated with
+  // the period of the last keyframe's t_s. Empty: the edge's fixed value.
+  std::vector<Keyframe> keyframes;
 };
+
+// Level-of-Error augmentations `covtrack view` can draw (seed 5.6.2), from the one that
+// relies most on registration to the one that relies on it least.
+enum class Augmentation { outline, region, label };
+const char* to_string(Augmentation a);
 
 struct SceneObject {
   std::string name;
   std::string frame;
   std::vector<Vec3> vertices_m;  // in the object's frame
+  // Level of Error: n ascending assessment thresholds (px) pick one of n + 1
+  // augmentations; empty: always the first.
+  std::vector<double> level_of_error_px;
+  double level_of_error_margin_px = 1;
+  std::vector<Augmentation> augmentations{Augmentation::outline};
+};
+
+enum class Likelihood { area, distance };
+
+// A tracked pointer (seed chapter 6): a point of a frame, projected with its error, that
+// selects among the objects.
+struct ScenePointer {
+  std::string frame;
+  Vec3 tip_m = Vec3::Zero();
+  Likelihood likelihood = Likelihood::area;
 };
 
 struct SceneCamera {
@@ -38,7 +69,13 @@ struct Scene {
   std::vector<SceneTransform> transforms;
   SceneCamera camera;
   std::vector<SceneObject> objects;
+  std::optional<ScenePointer> pointer;
 };
+
+// A scripted transform's value at scene_time_s: position and sigma scale interpolated
+// between its keyframes, repeating with the last keyframe's period; the transform itself
+// when it has no keyframes.
+SceneTransform scripted_value(const SceneTransform& t, double scene_time_s);
 
 // Every problem at once, each as file:line:column: key.path: what is wrong.
 Result<Scene> load_scene(const std::string& path);

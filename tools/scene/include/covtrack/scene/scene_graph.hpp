@@ -18,6 +18,11 @@ namespace covtrack::scene {
 Result<void> add_scene_transforms(const Scene& scene, client::TransformGraph& graph,
                                   std::optional<std::int64_t> reports_at_us);
 
+// Offline scripts: every transform with keyframes reports its value at scene_time_s
+// (scripted_value), measured at now_us. Edges without keyframes are left alone.
+Result<void> report_keyframes(const Scene& scene, client::TransformGraph& graph,
+                              double scene_time_s, std::int64_t now_us);
+
 struct HullObject {
   std::string name;
   std::string frame;

@@ -1,0 +1,29 @@
+#include "view_labels.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <fmt/format.h>
+
+namespace covtrack::cli {
+
+ViewLabels layout_labels(const RegionsReport& report, const WidgetFrame* widgets, const cv::Size& screen) {
+  ViewLabels out;
+  std::vector<client::LabelRequest> requests;
+  for (std::size_t i = 0; i < report.objects.size(); ++i) {
+    const RegionsReport::Object& o = report.objects[i];
+    const client::ObjectRegions& r = o.regions;
+    std::string text = r.valid ? fmt::format("{} {:.1f}px", o.name, r.assessment) : fmt::format("{}: no region", o.name);
+    int baseline = 0;
+    const cv::Size size = cv::getTextSize(text, kLabelFont, kLabelFontScale, 1, &baseline);
+    const client::Vec2 box(size.width + 2 * kLabelPad, size.height + baseline + 2 * kLabelPad);
+    const bool listed = widgets && widgets->augmentations[i] == scene::Augmentation::label;
+    requests.push_back(listed ? client::LabelRequest{{}, {}, box} : client::LabelRequest{r.inner, r.outer, box});
+    out.texts.push_back(std::move(text));
+  }
+  client::LabelPlacerOptions options;
+  options.screen = {client::Vec2(0, 0), client::Vec2(screen.width, screen.height)};
+  out.placed = client::place_labels(requests, options);
+  return out;
+}
+
+}  // namespace covtrack::cli

@@ -1,0 +1,51 @@
+#include "view_widgets.hpp"
+
+#include <fmt/format.h>
+
+namespace covtrack::cli {
+
+Result<ViewWidgets> ViewWidgets::create(const scene::Scene& scene) {
+  std::vector<client::LevelOfError> levels;
+  for (const scene::SceneObject& o : scene.objects) {
+    auto loe = client::LevelOfError::create(o.level_of_error_px, o.level_of_error_margin_px);
+    if (!loe) return fail(fmt::format("object {}: {}", o.name, loe.error().message));
+    levels.push_back(*loe);
+  }
+  return ViewWidgets(std::move(levels), scene);
+}
+
+ViewWidgets::ViewWidgets(std::vector<client::LevelOfError> levels, const scene::Scene& scene)
+    : levels_(std::move(levels)) {
+  for (const scene::SceneObject& o : scene.objects) augmentations_.push_back(o.augmentations);
+  if (scene.pointer) likelihood_ = scene.pointer->likelihood;
+}
+
+WidgetFrame ViewWidgets::update(const RegionsReport& report, const cv::Size& screen) {
+  WidgetFrame frame;
+  for (std::size_t i = 0; i < report.objects.size(); ++i) {
+    const int level = levels_[i].update(report.objects[i].regions.assessment);
+    frame.augmentations.push_back(augmentations_[i][static_cast<std::size_t>(level)]);
+  }
+  if (!likelihood_ || !report.pointer_tip) return frame;
+
+  frame.pointer = client::pointer_from_projection(*report.pointer_tip, report.confidence);
+  // Objects are selected by their outer regions: where the object can be on the screen.
+  std::vector<client::Selectable> selectables;
+  for (const RegionsReport::Object& o : report.objects) {
+    client::Selectable s{o.regions.outer, 0};
+    for (const client::ProjectedVertex& v : o.regions.vertices) s.depth_m += v.depth_m / o.regions.vertices.size();
+    selectables.push_back(std::move(s));
+  }
+  frame.likelihoods = *likelihood_ == scene::Likelihood::area
+                          ? client::likelihoods_by_area(*frame.pointer, selectables)
+                          : client::likelihoods_by_distance(*frame.pointer, selectables);
+  frame.selection = client::select_direct(frame.likelihoods, selectables);
+  if (frame.selection.ambiguous()) {
+    client::IndirectOptions options;
+    options.screen = {client::Vec2(0, 0), client::Vec2(screen.width, screen.height)};
+    frame.targets = client::layout_indirect_targets(frame.selection.candidates, *frame.pointer, options);
+  }
+  return frame;
+}
+
+}  // namespace covtrack::cli

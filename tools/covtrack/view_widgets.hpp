@@ -1,0 +1,44 @@
+#pragma once
+// The seed's adaptive widgets for each frame of `covtrack view`: every object's
+// Level-of-Error choice (5.6.2; its hysteresis needs the frames before, so this object
+// lives as long as the view) and, when the scene has a pointer, each object's selection
+// likelihood and the selection it makes (chapter 6).
+#include <optional>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "covtrack/client/level_of_error.hpp"
+#include "covtrack/client/selection.hpp"
+#include "covtrack/protocol/result.hpp"
+#include "covtrack/scene/scene.hpp"
+#include "regions_report.hpp"
+
+namespace covtrack::cli {
+
+struct WidgetFrame {
+  std::vector<scene::Augmentation> augmentations;  // the chosen one, per object
+  // With a pointer: per object, in [0, 1]; the selection; and, when several objects are
+  // candidates, the indirect targets (6.6.2) laid out above the pointer.
+  std::optional<client::Pointer> pointer;
+  std::vector<double> likelihoods;
+  client::DirectSelection selection;
+  std::vector<client::SelectionTarget> targets;
+};
+
+class ViewWidgets {
+ public:
+  // Fails naming the object whose Level-of-Error thresholds are invalid.
+  static Result<ViewWidgets> create(const scene::Scene& scene);
+
+  WidgetFrame update(const RegionsReport& report, const cv::Size& screen);
+
+ private:
+  ViewWidgets(std::vector<client::LevelOfError> levels, const scene::Scene& scene);
+
+  std::vector<client::LevelOfError> levels_;  // one per object
+  std::vector<std::vector<scene::Augmentation>> augmentations_;
+  std::optional<scene::Likelihood> likelihood_;  // none: the scene has no pointer
+};
+
+}  // namespace covtrack::cli
