@@ -55,7 +55,7 @@ void BM_Flock(benchmark::State& state) {
 
 // Arguments: bytes of noise, bytes per feed (1 MiB: the whole stream at once).
 void noise_and_chunks(benchmark::internal::Benchmark* b) {
-  for (long noise : {4096L, 65536L})
+  for (long noise : {4096L, 65536L, 262144L})
     for (long chunk : {4096L, 1L << 20}) b->Args({noise, chunk});
   b->Unit(benchmark::kMicrosecond);
 }
