@@ -2,9 +2,11 @@
 // and resync after garbage or a cut record.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include "covtrack/devices/serial6dof/record_encoder.hpp"
+#include "serial6dof_stream.hpp"
 
 using namespace covtrack;
 using namespace covtrack::serial6dof;
@@ -270,4 +272,66 @@ TEST(FlockDecoder, ResyncOnThePhasingBit) {
   for (const auto& r : recs) EXPECT_EQ(r.station, 2);
   EXPECT_GE(d.resyncs(), 3u);
   EXPECT_GE(d.bad_records(), 2u);
+}
+
+namespace {
+
+// Two long runs of noise, each followed by records, fed in reads of `chunk` bytes (an odd
+// size, so records straddle reads): every record must come out, and each run of noise
+// must count as exactly one resync, however many reads it spans.
+template <typename Decoder, typename Encode>
+void expect_records_after_long_noise(Decoder& d, Encode encode, std::size_t chunk, double tol) {
+  constexpr int kPerRun = 40;
+  Bytes stream;
+  std::vector<TrackerRecord> sent;
+  for (int run = 0; run < 2; ++run) {
+    const Bytes noise = test::noise_without_records(64 * 1024);
+    stream.insert(stream.end(), noise.begin(), noise.end());
+    for (int i = 0; i < kPerRun; ++i) {
+      sent.push_back(test::stream_record(run * kPerRun + i));
+      const Bytes r = encode(sent.back());
+      stream.insert(stream.end(), r.begin(), r.end());
+    }
+  }
+  std::vector<TrackerRecord> got;
+  for (std::size_t at = 0; at < stream.size(); at += chunk) {
+    const Bytes read(stream.begin() + static_cast<std::ptrdiff_t>(at),
+                     stream.begin() + static_cast<std::ptrdiff_t>(std::min(stream.size(), at + chunk)));
+    auto recs = records_of(d, read);
+    got.insert(got.end(), recs.begin(), recs.end());
+  }
+  ASSERT_EQ(got.size(), sent.size()) << "read size " << chunk;
+  for (std::size_t i = 0; i < sent.size(); ++i) expect_pose_near(got[i], sent[i], tol, tol);
+  EXPECT_EQ(d.resyncs(), 2u) << "read size " << chunk;
+  EXPECT_EQ(d.bad_records(), 0u) << d.last_problem();
+}
+
+}  // namespace
+
+TEST(FastrakDecoder, EveryRecordAfterLongNoiseAndOneResyncPerRun) {
+  const FastrakFormat f{Units::Centimetres, {FastrakExtra::Timestamp}, true};
+  for (std::size_t chunk : {std::size_t{777}, std::size_t{4096}, std::size_t{1} << 20}) {
+    FastrakDecoder d(f);
+    expect_records_after_long_noise(d, [&](const TrackerRecord& r) { return encode_fastrak_record(r, f); },
+                                    chunk, 1e-6);
+  }
+}
+
+TEST(LibertyDecoder, EveryRecordAfterLongNoiseAndOneResyncPerRun) {
+  const LibertyFormat f{Units::Centimetres, {LibertyExtra::Timestamp}};
+  for (std::size_t chunk : {std::size_t{777}, std::size_t{4096}, std::size_t{1} << 20}) {
+    LibertyDecoder d(f);
+    expect_records_after_long_noise(d, [&](const TrackerRecord& r) { return encode_liberty_record(r, f); },
+                                    chunk, 1e-6);
+  }
+}
+
+TEST(FlockDecoder, EveryRecordAfterLongNoiseAndOneResyncPerRun) {
+  const FlockFormat f{36, true, 1};
+  for (std::size_t chunk : {std::size_t{777}, std::size_t{4096}, std::size_t{1} << 20}) {
+    FlockDecoder d(f);
+    // 14-bit words: see GroupModeAddressAndNegativeValues.
+    expect_records_after_long_noise(d, [&](const TrackerRecord& r) { return encode_flock_record(r, f); },
+                                    chunk, 3e-4);
+  }
 }

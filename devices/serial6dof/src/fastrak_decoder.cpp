@@ -46,26 +46,19 @@ std::string fastrak_output_list_command(int station, const FastrakFormat& f) {
   return cmd;
 }
 
-void FastrakDecoder::skip_byte() {
-  if (!skipping_) ++resyncs_;  // one resync per run of skipped bytes
-  skipping_ = true;
-  buffer_.erase(buffer_.begin());
-}
-
 FastrakDecoder::Step FastrakDecoder::try_record(std::vector<DecodedItem>& out) {
   const std::size_t size = fastrak_record_size(format_);
-  if (buffer_.size() < 3) return Step::NeedMore;
-  const int station = fastrak_station_from_char(buffer_[1]);
-  const std::uint8_t status = buffer_[2];
+  if (input_.size() < 3) return Step::NeedMore;
+  const int station = fastrak_station_from_char(input_[1]);
+  const std::uint8_t status = input_[2];
   const bool status_valid = status == ' ' || (status >= 'A' && status <= 'Z');
   if (station == 0 || !status_valid) return Step::Skip;  // not a header
-  if (buffer_.size() < size) return Step::NeedMore;
-  const std::uint8_t* p = buffer_.data();
+  if (input_.size() < size) return Step::NeedMore;
+  const std::uint8_t* p = input_.data();
   const bool end_ok = format_.crlf_terminator ? (p[size - 2] == '\r' && p[size - 1] == '\n')
                                               : p[size - 1] == ' ';
   if (!end_ok) {  // a cut record or garbage that looked like a header
-    ++bad_records_;
-    last_problem_ = "record without its terminator (cut or corrupt)";
+    input_.reject("record without its terminator (cut or corrupt)");
     return Step::Skip;
   }
   TrackerRecord r;
@@ -87,45 +80,43 @@ FastrakDecoder::Step FastrakDecoder::try_record(std::vector<DecodedItem>& out) {
     at += extra_size(e);
   }
   if (const auto problem = record_problem(r)) {
-    ++bad_records_;
-    last_problem_ = *problem;
+    input_.reject(*problem);
     return Step::Skip;
   }
   out.emplace_back(std::move(r));
-  buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(size));
+  input_.take(size);
   return Step::Item;
 }
 
 FastrakDecoder::Step FastrakDecoder::try_status(std::vector<DecodedItem>& out) {
-  if (buffer_.size() < 3) return Step::NeedMore;
-  const int station = fastrak_station_from_char(buffer_[1]);
-  if (station == 0 || buffer_[2] != 'S') return Step::Skip;
-  const std::size_t limit = std::min(buffer_.size(), kMaxStatusRecord);
+  if (input_.size() < 3) return Step::NeedMore;
+  const int station = fastrak_station_from_char(input_[1]);
+  if (station == 0 || input_[2] != 'S') return Step::Skip;
+  const std::size_t limit = std::min(input_.size(), kMaxStatusRecord);
   for (std::size_t i = 3; i < limit; ++i) {
-    if (buffer_[i] != '\n') continue;
-    DeviceReply reply{'S', station, 0, std::string(buffer_.begin(), buffer_.begin() + i + 1)};
-    out.emplace_back(std::move(reply));
-    buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(i + 1));
+    if (input_[i] != '\n') continue;
+    const char* text = reinterpret_cast<const char*>(input_.data());
+    out.emplace_back(DeviceReply{'S', station, 0, std::string(text, i + 1)});
+    input_.take(i + 1);
     return Step::Item;
   }
-  if (buffer_.size() >= kMaxStatusRecord) {
-    ++bad_records_;
-    last_problem_ = "status record without its line end";
+  if (input_.size() >= kMaxStatusRecord) {
+    input_.reject("status record without its line end");
     return Step::Skip;
   }
   return Step::NeedMore;
 }
 
 std::vector<DecodedItem> FastrakDecoder::feed(std::span<const std::uint8_t> bytes) {
-  buffer_.insert(buffer_.end(), bytes.begin(), bytes.end());
+  input_.append(bytes);
   std::vector<DecodedItem> out;
-  while (!buffer_.empty()) {
+  while (!input_.empty()) {
     Step step = Step::Skip;
-    if (buffer_[0] == '0') step = try_record(out);
-    else if (buffer_[0] == '2') step = try_status(out);
+    if (input_[0] == '0') step = try_record(out);
+    else if (input_[0] == '2') step = try_status(out);
     if (step == Step::NeedMore) break;
-    if (step == Step::Skip) skip_byte();
-    else skipping_ = false;
+    // Binary records start with '0', status records with '2'.
+    if (step == Step::Skip) input_.skip_to_next([](std::uint8_t b) { return b == '0' || b == '2'; });
   }
   return out;
 }

@@ -7,35 +7,30 @@ namespace covtrack::serial6dof {
 
 std::size_t flock_record_size(const FlockFormat& f) { return f.group_mode ? 15 : 14; }
 
-void FlockDecoder::skip_byte() {
-  if (!skipping_) ++resyncs_;
-  skipping_ = true;
-  buffer_.erase(buffer_.begin());
+void FlockDecoder::skip_to_next_record() {
+  input_.skip_to_next([](std::uint8_t b) { return (b & 0x80) != 0; });
 }
 
 std::vector<DecodedItem> FlockDecoder::feed(std::span<const std::uint8_t> bytes) {
-  buffer_.insert(buffer_.end(), bytes.begin(), bytes.end());
+  input_.append(bytes);
   std::vector<DecodedItem> out;
   const std::size_t size = flock_record_size(format_);
-  while (!buffer_.empty()) {
-    if (!(buffer_[0] & 0x80)) {  // not the first byte of a record
-      skip_byte();
+  while (!input_.empty()) {
+    if (!(input_[0] & 0x80)) {  // not the first byte of a record
+      skip_to_next_record();
       continue;
     }
     // A phasing bit inside the record means the previous record was cut short.
     std::size_t cut = 0;
-    for (std::size_t i = 1; i < std::min(size, buffer_.size()) && !cut; ++i)
-      if (buffer_[i] & 0x80) cut = i;
+    for (std::size_t i = 1; i < std::min(size, input_.size()) && !cut; ++i)
+      if (input_[i] & 0x80) cut = i;
     if (cut) {
-      ++bad_records_;
-      last_problem_ = "record cut short (phasing bit inside it)";
-      if (!skipping_) ++resyncs_;
-      skipping_ = true;
-      buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(cut));
+      input_.reject("record cut short (phasing bit inside it)");
+      input_.skip(cut);
       continue;
     }
-    if (buffer_.size() < size) break;
-    const std::uint8_t* p = buffer_.data();
+    if (input_.size() < size) break;
+    const std::uint8_t* p = input_.data();
     double w[7];
     for (int i = 0; i < 7; ++i) w[i] = decode_phased_word(p[2 * i], p[2 * i + 1]);
     TrackerRecord r;
@@ -45,14 +40,12 @@ std::vector<DecodedItem> FlockDecoder::feed(std::span<const std::uint8_t> bytes)
     r.orientation = Eigen::Quaterniond(w[3] / 32768.0, w[4] / 32768.0, w[5] / 32768.0,
                                        w[6] / 32768.0);
     if (const auto problem = record_problem(r)) {
-      ++bad_records_;
-      last_problem_ = *problem;
-      skip_byte();
+      input_.reject(*problem);
+      skip_to_next_record();
       continue;
     }
     out.emplace_back(std::move(r));
-    skipping_ = false;
-    buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(size));
+    input_.take(size);
   }
   return out;
 }

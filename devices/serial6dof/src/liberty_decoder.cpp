@@ -26,36 +26,33 @@ std::string liberty_output_list_command(int station, const LibertyFormat& f) {
   return cmd + ",1\r";
 }
 
-void LibertyDecoder::skip_byte() {
-  if (!skipping_) ++resyncs_;
-  skipping_ = true;
-  buffer_.erase(buffer_.begin());
+void LibertyDecoder::skip_to_next_preamble() {
+  input_.skip_to_next([](std::uint8_t b) { return b == 'L' || b == 'P' || b == 'M'; });
 }
 
 std::vector<DecodedItem> LibertyDecoder::feed(std::span<const std::uint8_t> bytes) {
-  buffer_.insert(buffer_.end(), bytes.begin(), bytes.end());
+  input_.append(bytes);
   std::vector<DecodedItem> out;
-  while (buffer_.size() >= 2) {
-    if (!is_liberty_preamble(buffer_[0], buffer_[1])) {
-      skip_byte();
+  while (input_.size() >= 2) {
+    if (!is_liberty_preamble(input_[0], input_[1])) {
+      skip_to_next_preamble();
       continue;
     }
-    if (buffer_.size() < kLibertyHeaderSize) break;
-    const std::uint8_t* h = buffer_.data();
+    if (input_.size() < kLibertyHeaderSize) break;
+    const std::uint8_t* h = input_.data();
     const std::size_t size = read_u16_le(h + 6);
     if (size > kMaxPayload || h[2] == 0) {  // a preamble look-alike inside data
-      skip_byte();
+      skip_to_next_preamble();
       continue;
     }
-    if (buffer_.size() < kLibertyHeaderSize + size) break;
+    if (input_.size() < kLibertyHeaderSize + size) break;
     const std::uint8_t* p = h + kLibertyHeaderSize;
     const char command = static_cast<char>(h[3]);
     if (command == 'C' || command == 'P') {
       if (size != liberty_payload_size(format_) || p[size - 2] != '\r' || p[size - 1] != '\n') {
-        ++bad_records_;
-        last_problem_ = fmt::format("pose frame of {} bytes, expected {} ending in CR LF", size,
-                                    liberty_payload_size(format_));
-        skip_byte();
+        input_.reject(fmt::format("pose frame of {} bytes, expected {} ending in CR LF", size,
+                                  liberty_payload_size(format_)));
+        skip_to_next_preamble();
         continue;
       }
       TrackerRecord r;
@@ -73,9 +70,8 @@ std::vector<DecodedItem> LibertyDecoder::feed(std::span<const std::uint8_t> byte
         at += 4;
       }
       if (const auto problem = record_problem(r)) {
-        ++bad_records_;
-        last_problem_ = *problem;
-        skip_byte();
+        input_.reject(*problem);
+        skip_to_next_preamble();
         continue;
       }
       out.emplace_back(std::move(r));
@@ -83,8 +79,7 @@ std::vector<DecodedItem> LibertyDecoder::feed(std::span<const std::uint8_t> byte
       out.emplace_back(DeviceReply{command, h[2], liberty_error_is_ok(h[4]) ? 0 : h[4],
                                    std::string(p, p + size)});
     }
-    skipping_ = false;
-    buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(kLibertyHeaderSize + size));
+    input_.take(kLibertyHeaderSize + size);
   }
   return out;
 }

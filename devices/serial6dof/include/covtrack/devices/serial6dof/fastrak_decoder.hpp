@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "covtrack/devices/serial6dof/resync_buffer.hpp"
 #include "covtrack/devices/serial6dof/tracker_record.hpp"
 
 namespace covtrack::serial6dof {
@@ -33,21 +34,17 @@ class FastrakDecoder {
 
   std::vector<DecodedItem> feed(std::span<const std::uint8_t> bytes);
 
-  std::uint64_t resyncs() const { return resyncs_; }        // times bytes were skipped
-  std::uint64_t bad_records() const { return bad_records_; }  // framed but rejected
-  const std::string& last_problem() const { return last_problem_; }
+  std::uint64_t resyncs() const { return input_.resyncs(); }        // runs of skipped bytes
+  std::uint64_t bad_records() const { return input_.bad_records(); }  // framed but rejected
+  const std::string& last_problem() const { return input_.last_problem(); }
 
  private:
   enum class Step { Item, NeedMore, Skip };
   Step try_record(std::vector<DecodedItem>& out);
   Step try_status(std::vector<DecodedItem>& out);
-  void skip_byte();
 
   FastrakFormat format_;
-  std::vector<std::uint8_t> buffer_;
-  bool skipping_ = false;
-  std::uint64_t resyncs_ = 0, bad_records_ = 0;
-  std::string last_problem_;
+  ResyncBuffer input_;
 };
 
 // Units reported by a status record ('S' reply): system-flags bit 1 (0 inches, 1 cm);

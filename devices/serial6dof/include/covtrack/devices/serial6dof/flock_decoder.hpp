@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "covtrack/devices/serial6dof/resync_buffer.hpp"
 #include "covtrack/devices/serial6dof/tracker_record.hpp"
 
 namespace covtrack::serial6dof {
@@ -25,18 +26,15 @@ class FlockDecoder {
 
   std::vector<DecodedItem> feed(std::span<const std::uint8_t> bytes);
 
-  std::uint64_t resyncs() const { return resyncs_; }
-  std::uint64_t bad_records() const { return bad_records_; }
-  const std::string& last_problem() const { return last_problem_; }
+  std::uint64_t resyncs() const { return input_.resyncs(); }
+  std::uint64_t bad_records() const { return input_.bad_records(); }
+  const std::string& last_problem() const { return input_.last_problem(); }
 
  private:
-  void skip_byte();
+  void skip_to_next_record();
 
   FlockFormat format_;
-  std::vector<std::uint8_t> buffer_;
-  bool skipping_ = false;
-  std::uint64_t resyncs_ = 0, bad_records_ = 0;
-  std::string last_problem_;
+  ResyncBuffer input_;
 };
 
 }  // namespace covtrack::serial6dof

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "covtrack/devices/serial6dof/resync_buffer.hpp"
 #include "covtrack/devices/serial6dof/tracker_record.hpp"
 
 namespace covtrack::serial6dof {
@@ -33,17 +34,14 @@ class LibertyDecoder {
 
   std::vector<DecodedItem> feed(std::span<const std::uint8_t> bytes);
 
-  std::uint64_t resyncs() const { return resyncs_; }
-  std::uint64_t bad_records() const { return bad_records_; }
-  const std::string& last_problem() const { return last_problem_; }
+  std::uint64_t resyncs() const { return input_.resyncs(); }
+  std::uint64_t bad_records() const { return input_.bad_records(); }
+  const std::string& last_problem() const { return input_.last_problem(); }
 
  private:
-  void skip_byte();
+  void skip_to_next_preamble();
   LibertyFormat format_;
-  std::vector<std::uint8_t> buffer_;
-  bool skipping_ = false;
-  std::uint64_t resyncs_ = 0, bad_records_ = 0;
-  std::string last_problem_;
+  ResyncBuffer input_;
 };
 
 bool is_liberty_preamble(std::uint8_t a, std::uint8_t b);
