@@ -22,9 +22,6 @@ const cv::Scalar kBlue(255, 120, 0), kGreen(0, 200, 0), kWhite(255, 255, 255),
     kGrey(160, 160, 160), kRed(0, 0, 255), kYellow(0, 230, 230), kLegend(210, 210, 210),
     kPanel(30, 30, 30), kCyan(230, 200, 0), kMagenta(230, 0, 230);
 
-const int kFont = kLabelFont;
-constexpr double kFontScale = kLabelFontScale;
-
 cv::Point fixed_point(const client::Vec2& p) {
   return {cvRound(p.x() * kScale), cvRound(p.y() * kScale)};
 }
@@ -85,7 +82,7 @@ void draw_vertex_ellipses(cv::Mat& image, const client::ObjectRegions& r, double
 void draw_box(cv::Mat& image, const client::Box& b, const std::string& text, const cv::Scalar& colour) {
   const cv::Rect box(cvRound(b.min.x()), cvRound(b.min.y()), cvRound(b.width()), cvRound(b.height()));
   cv::rectangle(image, box, kPanel, cv::FILLED);
-  cv::putText(image, text, cv::Point(box.x + kLabelPad, box.y + box.height - kLabelPad - 3), kFont, kFontScale,
+  cv::putText(image, text, cv::Point(box.x + kLabelPad, box.y + box.height - kLabelPad - 3), kLabelFont, kLabelFontScale,
               colour, 1, cv::LINE_AA);
 }
 
@@ -147,12 +144,12 @@ void draw_legend(cv::Mat& image, const std::vector<std::string>& lines) {
   constexpr int kLine = 16, kMargin = 6;
   int width = 0;
   for (const std::string& line : lines)
-    width = std::max(width, cv::getTextSize(line, kFont, 0.4, 1, nullptr).width);
+    width = std::max(width, cv::getTextSize(line, kLabelFont, 0.4, 1, nullptr).width);
   const int height = std::min(image.rows, int(lines.size()) * kLine + kMargin);
   const cv::Rect panel(0, image.rows - height, std::min(image.cols, width + 2 * kMargin), height);
   image(panel) = kPanel;
   for (std::size_t i = 0; i < lines.size(); ++i)
-    cv::putText(image, lines[i], cv::Point(kMargin, panel.y + kLine * int(i + 1) - 2), kFont, 0.4, kLegend, 1,
+    cv::putText(image, lines[i], cv::Point(kMargin, panel.y + kLine * int(i + 1) - 2), kLabelFont, 0.4, kLegend, 1,
                 cv::LINE_AA);
 }
 

@@ -185,11 +185,11 @@ SceneObject read_object(TableReader& r) {
   o.level_of_error_margin_px = r.number("level_of_error_margin_px", 1);
   if (r.has("augmentations")) {
     o.augmentations.clear();
+    constexpr Augmentation kAll[] = {Augmentation::outline, Augmentation::region, Augmentation::label};
     for (const std::string& name : r.strings("augmentations")) {
-      if (name == "outline") o.augmentations.push_back(Augmentation::outline);
-      else if (name == "region") o.augmentations.push_back(Augmentation::region);
-      else if (name == "label") o.augmentations.push_back(Augmentation::label);
-      else r.error("augmentations", fmt::format("'{}' is not outline, region or label", name));
+      const auto* known = std::find_if(std::begin(kAll), std::end(kAll), [&](Augmentation a) { return name == to_string(a); });
+      if (known == std::end(kAll)) r.error("augmentations", fmt::format("'{}' is not outline, region or label", name));
+      else o.augmentations.push_back(*known);
     }
   }
   if (o.augmentations.size() != o.level_of_error_px.size() + 1)
