@@ -1,7 +1,14 @@
 // The serial transport over a real pseudo-terminal: bytes both ways, read timeouts, a
-// device that is unplugged (error, not exception or crash) and plugged back in.
+// device that is unplugged (error, not exception or crash) and plugged back in, and
+// paths that are not serial devices at all.
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 
 #include <chrono>
 #include <cstdint>
@@ -81,6 +88,52 @@ TEST(SerialTransport, MissingDeviceIsAClearError) {
   ASSERT_FALSE(port);
   EXPECT_NE(port.error().message.find("/dev/covtrack-no-such-tty"), std::string::npos) << port.error().message;
   EXPECT_NE(port.error().message.find("no such device"), std::string::npos) << port.error().message;
+}
+
+// Config typos: libserial 1.0.0 aborts the process on a path that opens but is not a
+// terminal (it throws again from its destructor), so these must come back as errors.
+TEST(SerialTransport, RegularFileIsAClearErrorNotACrash) {
+  const std::string path = link_path("plain_file");
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fclose(f);
+  auto port = SerialPort::open({.path = path, .baud = 19200});
+  ASSERT_FALSE(port);
+  EXPECT_NE(port.error().message.find(path), std::string::npos) << port.error().message;
+  EXPECT_NE(port.error().message.find("regular file, not a serial device"), std::string::npos)
+      << port.error().message;
+  std::remove(path.c_str());
+}
+
+TEST(SerialTransport, DirectoryIsAClearError) {
+  auto port = SerialPort::open({.path = ::testing::TempDir(), .baud = 19200});
+  ASSERT_FALSE(port);
+  EXPECT_NE(port.error().message.find("directory, not a serial device"), std::string::npos)
+      << port.error().message;
+}
+
+TEST(SerialTransport, CharacterDeviceThatIsNotATerminalIsAClearErrorNotACrash) {
+  for (int attempt = 0; attempt < 3; ++attempt) {  // the teardown must also be repeatable
+    auto port = SerialPort::open({.path = "/dev/null", .baud = 19200});
+    ASSERT_FALSE(port);
+    EXPECT_NE(port.error().message.find("cannot be set up as a terminal"), std::string::npos)
+        << port.error().message;
+  }
+}
+
+// A pseudo-terminal slave that is still locked refuses open() with EIO; libserial would
+// report "Bad file descriptor" (it calls close(-1) before reading errno).
+TEST(SerialTransport, RefusedOpenReportsTheRealError) {
+  const int master = ::posix_openpt(O_RDWR | O_NOCTTY);
+  ASSERT_GE(master, 0);
+  ASSERT_EQ(::grantpt(master), 0);
+  char name[128];
+  ASSERT_EQ(::ptsname_r(master, name, sizeof name), 0);
+  auto port = SerialPort::open({.path = name, .baud = 19200});
+  ::close(master);
+  ASSERT_FALSE(port);
+  EXPECT_NE(port.error().message.find(std::strerror(EIO)), std::string::npos) << port.error().message;
+  EXPECT_EQ(port.error().message.find(std::strerror(EBADF)), std::string::npos) << port.error().message;
 }
 
 TEST(SerialTransport, UnsupportedBaudIsRejected) {

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/ioctl.h>
+#include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -52,6 +53,34 @@ Result<void> make_raw_nonblocking(int fd) {
   return {};
 }
 
+// A regular file, a directory or a missing path is told apart before libserial gets it:
+// libserial 1.0.0 opens anything, and on a file that is not a terminal it throws from its
+// destructor, which would terminate the daemon over a typo in a config.
+Result<void> check_device_kind(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return fail(fmt::format("no such device ({})", std::strerror(errno)));
+  if (S_ISCHR(st.st_mode)) return {};
+  if (S_ISDIR(st.st_mode)) return fail("is a directory, not a serial device");
+  if (S_ISREG(st.st_mode)) return fail("is a regular file, not a serial device");
+  return fail("is not a character device, so not a serial device");
+}
+
+// libserial 1.0.0 calls close(-1) before formatting errno, so its message for every failed
+// open is "Bad file descriptor". Repeat the open (it just failed, so it fails again the
+// same way, almost always) to report the real errno.
+std::string open_failure_reason(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd >= 0) {
+    ::close(fd);
+    return "refused once, then opened (device busy or being re-plugged?)";
+  }
+  const int error = errno;
+  const std::string text = std::strerror(error);
+  if (error == EBUSY) return text + " (another program holds it exclusively)";
+  if (error == EACCES) return text + " (add the user to the 'dialout' group?)";
+  return text;
+}
+
 }  // namespace
 
 SerialPort::SerialPort(std::unique_ptr<LibSerial::SerialPort> port, std::string path)
@@ -63,14 +92,20 @@ Result<std::unique_ptr<SerialPort>> SerialPort::open(const SerialSettings& setti
   const auto where = [&](const std::string& what) { return fmt::format("serial port {}: {}", settings.path, what); };
   if (!is_supported_baud(settings.baud))
     return fail(where(fmt::format("unsupported baud rate {}", settings.baud)));
-  if (::access(settings.path.c_str(), F_OK) != 0)
-    return fail(where(fmt::format("no such device ({})", std::strerror(errno))));
+  if (auto kind = check_device_kind(settings.path); !kind) return fail(where(kind.error().message));
 
   auto lib_port = std::make_unique<LibSerial::SerialPort>();
   try {
     lib_port->Open(settings.path);
   } catch (const std::exception& e) {
-    return fail(where(fmt::format("cannot open: {}", e.what())));
+    if (lib_port->IsOpen()) {
+      // The descriptor opened but is not a terminal (tcgetattr failed): libserial would
+      // throw again from its destructor. Hand it to the safe teardown instead.
+      SerialPort doomed(std::move(lib_port), settings.path);
+      doomed.disconnected_ = true;
+      return fail(where(fmt::format("opened but cannot be set up as a terminal: {}", e.what())));
+    }
+    return fail(where(fmt::format("cannot open: {}", open_failure_reason(settings.path))));
   }
   // From here on the wrapper owns the port, so every failure path tears down safely.
   std::unique_ptr<SerialPort> port(new SerialPort(std::move(lib_port), settings.path));
