@@ -83,8 +83,12 @@ TEST(FastrakDecoder, BothUnitsAndEveryOptionalItem) {
         expect_pose_near(recs[0], r, 1e-6, 1e-6);
         const bool has_time = std::find(extras.begin(), extras.end(), FastrakExtra::Timestamp) != extras.end();
         EXPECT_EQ(recs[0].device_time_s.has_value(), has_time);
-        if (has_time) EXPECT_NEAR(*recs[0].device_time_s, 12.5, 1e-6);
-        if (!extras.empty() && extras.back() != FastrakExtra::Timestamp) EXPECT_EQ(recs[0].buttons.value_or(9), 1u);
+        if (has_time) {
+          EXPECT_NEAR(*recs[0].device_time_s, 12.5, 1e-6);
+        }
+        if (!extras.empty() && extras.back() != FastrakExtra::Timestamp) {
+          EXPECT_EQ(recs[0].buttons.value_or(9), 1u);
+        }
         EXPECT_EQ(d.resyncs(), 0u);
       }
     }

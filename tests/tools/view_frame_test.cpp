@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include <opencv2/imgproc.hpp>
+
 #include "covtrack/client/convex_polygon.hpp"
 #include "covtrack/scene/scene_graph.hpp"
 #include "regions_report.hpp"
@@ -76,8 +78,12 @@ TEST(ViewFrame, LevelOfErrorRisesAndFallsWithoutFlicker) {
       const Augmentation now = f.widgets.augmentations[object];
       if (sequence.empty() || sequence.back() != now) {
         // A change happens only past its threshold (6 and 30 px, margin 1.5 going down).
-        if (!sequence.empty() && now > sequence.back()) EXPECT_GE(a, now == Augmentation::region ? 6 : 30);
-        if (!sequence.empty() && now < sequence.back()) EXPECT_LT(a, now == Augmentation::outline ? 4.5 : 28.5);
+        if (!sequence.empty() && now > sequence.back()) {
+          EXPECT_GE(a, now == Augmentation::region ? 6 : 30);
+        }
+        if (!sequence.empty() && now < sequence.back()) {
+          EXPECT_LT(a, now == Augmentation::outline ? 4.5 : 28.5);
+        }
         sequence.push_back(now);
       }
     }
@@ -96,9 +102,10 @@ TEST(ViewFrame, LabelsGoFromInsideTheDrawersToLeaderLinesToTheListAndBack) {
     const auto& placed = f.labels.placed;
     for (std::size_t i = 0; i < placed.size(); ++i) {
       const client::ObjectRegions& r = f.report.objects[i].regions;
-      if (placed[i].placement == LabelPlacement::inside_inner)
+      if (placed[i].placement == LabelPlacement::inside_inner) {
         for (const client::Vec2& corner : client::box_polygon(placed[i].box))
           EXPECT_TRUE(client::polygon_contains(r.inner, corner, 1e-6)) << f.time_s << " s, object " << i;
+      }
       if (placed[i].placement == LabelPlacement::outside_outer) {
         EXPECT_FALSE(client::box_meets_convex(placed[i].box, r.outer)) << f.time_s << " s, object " << i;
         EXPECT_TRUE(placed[i].leader);
@@ -142,6 +149,12 @@ TEST(ViewFrame, PointerSelectsTheDrawerUnderItAndSpreadsTargetsWhenAmbiguous) {
     if (!w.selection.ambiguous()) continue;
     ambiguous_seen = true;
     ASSERT_EQ(w.targets.size(), w.selection.candidates.size()) << f.time_s;
+    // Each target shows its object's whole name.
+    for (const client::SelectionTarget& t : w.targets) {
+      const std::string& name = f.report.objects[static_cast<std::size_t>(t.object)].name;
+      const int text = cv::getTextSize(name, kLabelFont, kLabelFontScale, 1, nullptr).width;
+      EXPECT_GE(t.box.width(), text + 2 * kLabelPad - 1e-9) << name << " at " << f.time_s << " s";
+    }
     // Indirect targets: any two farther apart than the pointer's region can reach.
     const double error = client::pointer_error_px(*w.pointer);
     for (std::size_t i = 0; i < w.targets.size(); ++i)

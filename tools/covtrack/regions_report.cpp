@@ -17,7 +17,7 @@ Result<RegionsModel> load_regions_model(const std::string& scene_path, double co
 
 Result<RegionsReport> compute_regions(const RegionsModel& model, const client::TransformGraph& graph,
                                       std::int64_t time_us, client::ProjectionMethod method) {
-  RegionsReport report{model.camera, model.scene.camera.frame, model.confidence, {}};
+  RegionsReport report{model.camera, model.scene.camera.frame, model.confidence, {}, std::nullopt};
   client::ObjectRegionOptions options;
   options.projection.method = method;
   options.regions.confidence = model.confidence;

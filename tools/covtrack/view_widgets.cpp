@@ -1,6 +1,12 @@
 #include "view_widgets.hpp"
 
+#include <algorithm>
+
+#include <opencv2/imgproc.hpp>
+
 #include <fmt/format.h>
+
+#include "view_labels.hpp"
 
 namespace covtrack::cli {
 
@@ -43,6 +49,12 @@ WidgetFrame ViewWidgets::update(const RegionsReport& report, const cv::Size& scr
   if (frame.selection.ambiguous()) {
     client::IndirectOptions options;
     options.screen = {client::Vec2(0, 0), client::Vec2(screen.width, screen.height)};
+    // Wide enough for the longest candidate's name: a cut name cannot be told apart.
+    for (int object : frame.selection.candidates) {
+      const std::string& name = report.objects[static_cast<std::size_t>(object)].name;
+      const double width = cv::getTextSize(name, kLabelFont, kLabelFontScale, 1, nullptr).width + 2 * kLabelPad;
+      options.target_size_px.x() = std::max(options.target_size_px.x(), width);
+    }
     frame.targets = client::layout_indirect_targets(frame.selection.candidates, *frame.pointer, options);
   }
   return frame;

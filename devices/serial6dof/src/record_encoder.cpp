@@ -1,8 +1,9 @@
 #include "covtrack/devices/serial6dof/record_encoder.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
-#include <algorithm>
+#include <iterator>
 
 #include <fmt/format.h>
 
@@ -54,11 +55,15 @@ Bytes encode_fastrak_status(int station, Units units) {
 
 Bytes encode_liberty_frame(int station, char command, std::uint8_t error, const Bytes& payload,
                            const char preamble[2]) {
-  Bytes b = {static_cast<std::uint8_t>(preamble[0]), static_cast<std::uint8_t>(preamble[1]),
-             static_cast<std::uint8_t>(station), static_cast<std::uint8_t>(command), error, 0,
-             static_cast<std::uint8_t>(payload.size() & 0xFF),
-             static_cast<std::uint8_t>(payload.size() >> 8)};
-  b.insert(b.end(), payload.begin(), payload.end());
+  const std::uint8_t header[] = {static_cast<std::uint8_t>(preamble[0]), static_cast<std::uint8_t>(preamble[1]),
+                                 static_cast<std::uint8_t>(station), static_cast<std::uint8_t>(command), error, 0,
+                                 static_cast<std::uint8_t>(payload.size() & 0xFF),
+                                 static_cast<std::uint8_t>(payload.size() >> 8)};
+  // Sized once and copied into: GCC 12 warns (-Warray-bounds, falsely) on an insert after
+  // an initializer-list construction.
+  Bytes b(sizeof header + payload.size());
+  std::copy(std::begin(header), std::end(header), b.begin());
+  std::copy(payload.begin(), payload.end(), b.begin() + sizeof header);
   return b;
 }
 
