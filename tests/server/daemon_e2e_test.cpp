@@ -165,7 +165,10 @@ TEST(DaemonEndToEnd, FailingDeviceRestartsWhileTheOtherKeepsPublishing) {
   EXPECT_GT(span_s, 1.5);
   EXPECT_GT(steady.received, 0.95 * 200 * span_s) << "over " << span_s << " s";
   EXPECT_EQ(steady.gaps, 0);
-  EXPECT_LT(steady.max_interval_us, 50000) << "the steady device stalled";
+  // A stall caused by the flaky device's restarts would last at least its back-off
+  // (0.2 s); below that bound lie the scheduling hiccups of a loaded 2-core machine
+  // (82 ms seen with parallel builds running).
+  EXPECT_LT(steady.max_interval_us, 150000) << "the steady device stalled";
   ASSERT_TRUE(c.status.count("flaky"));
   EXPECT_GE(c.status["flaky"].restarts, 2);
   EXPECT_GE(c.status["flaky"].errors, 2);

@@ -3,6 +3,7 @@
 // recorded session at its own time (--log); tracked edges grow with report age, so
 // latency shows as error. Output: a window when a display exists, else one PNG (--png)
 // or a video (--video).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -10,12 +11,15 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include <opencv2/highgui.hpp>
 #include <opencv2/videoio.hpp>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "commands.hpp"
 #include "covtrack/client/subscriber.hpp"
@@ -70,12 +74,20 @@ std::string selection_line(const RegionsReport& report, const WidgetFrame& w) {
   if (!w.pointer) return {};
   if (w.pointer->lost) return "pointer: no usable position, selects nothing";
   const auto& s = w.selection;
-  const std::string head = "pointer (fill: yellow p=0 to red p=1): ";
+  const std::string head = "pointer (yellow p=0, red p=1): ";
   if (!s.selected) return head + "selects nothing";
-  const std::string name = fmt::format("{} (p={:.2f})", report.objects[static_cast<std::size_t>(*s.selected)].name,
-                                       w.likelihoods[static_cast<std::size_t>(*s.selected)]);
-  if (!s.ambiguous()) return head + fmt::format("selects {}", name);
-  return head + fmt::format("{} candidates, best {}: pick a target", s.candidates.size(), name);
+  const auto named = [&](int object) {
+    const auto i = static_cast<std::size_t>(object);
+    return fmt::format("{} p={:.2f}", report.objects[i].name, w.likelihoods[i]);
+  };
+  if (!s.ambiguous()) return head + "selects " + named(*s.selected);
+  // Area likelihoods are per object (the share of the pointer's region on it), so two
+  // can both be 1: list the candidates rather than one "best".
+  constexpr std::size_t kListed = 3;
+  std::vector<std::string> listed;
+  for (std::size_t k = 0; k < std::min(kListed, s.candidates.size()); ++k) listed.push_back(named(s.candidates[k]));
+  if (s.candidates.size() > kListed) listed.push_back("...");
+  return head + fmt::format("pick a target of {}: {}", s.candidates.size(), fmt::join(listed, ", "));
 }
 
 int run_view(const ViewArgs& args) {
