@@ -1,8 +1,8 @@
 // `covtrack view SCENE`: every object's registration error drawn over the camera view,
 // from the scene's fixed values, or from the daemon's streams (--live), or from a
-// recorded session at its own time (--log, with the session's camera frames behind the
-// regions when it has them); tracked edges grow with report age, so latency shows as
-// error. Output: a window when a display exists, else one PNG (--png) or a video (--video).
+// recorded session at its own time (--log); tracked edges grow with report age, so
+// latency shows as error. Output: a window when a display exists, else one PNG (--png)
+// or a video (--video).
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
