@@ -28,6 +28,7 @@ std::string pose_channel(std::string_view d, std::string_view s) { return join(k
 std::string truth_channel(std::string_view d, std::string_view s) { return join(kTruthPrefix, d, s); }
 std::string status_channel(std::string_view d) { return join(kStatusPrefix, d); }
 std::string raw_channel(std::string_view d) { return join(kRawPrefix, d); }
+std::string image_channel(std::string_view d) { return join(kImagePrefix, d); }
 
 std::optional<StreamId> parse_pose_channel(std::string_view channel) {
   if (!channel.starts_with(kPosePrefix)) return std::nullopt;

@@ -29,6 +29,9 @@ class DeviceRunner::Sink final : public SampleSink {
   void raw(ByteDirection d, const std::uint8_t* data, std::size_t size) override {
     if (!r_.publisher_.raw(r_.device_.name, d, data, size)) ++r_.drops_;
   }
+  void image(const ImageSample& s) override {
+    if (!r_.publisher_.image(r_.device_.name, s)) ++r_.drops_;
+  }
   void count_error(const std::string& what) override {
     ++r_.errors_;
     std::lock_guard lock(r_.last_error_mutex_);

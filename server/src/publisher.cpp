@@ -1,5 +1,6 @@
 #include "publisher.hpp"
 
+#include <covtrack/image_t.hpp>
 #include <covtrack/pose_cov_t.hpp>
 #include <covtrack/raw_bytes_t.hpp>
 #include <covtrack/truth_pose_t.hpp>
@@ -61,6 +62,19 @@ bool Publisher::raw(const std::string& device, ByteDirection direction, const st
   msg.data.assign(data, data + size);
   std::lock_guard lock(mutex_);
   return send(raw_channel(device), msg);
+}
+
+bool Publisher::image(const std::string& device, const ImageSample& s) {
+  image_t msg;
+  msg.measurement_time_us = s.measurement_time_us;
+  msg.device = device;
+  msg.width = s.width;
+  msg.height = s.height;
+  msg.encoding = s.encoding;
+  msg.size = static_cast<std::int32_t>(s.bytes.size());
+  msg.data = s.bytes;
+  std::lock_guard lock(mutex_);
+  return send(image_channel(device), msg);
 }
 
 bool Publisher::status(const device_status_t& status) {

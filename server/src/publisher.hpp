@@ -24,6 +24,7 @@ class Publisher {
   bool truth(const std::string& device, const TruthSample& sample);
   bool raw(const std::string& device, ByteDirection direction, const std::uint8_t* data,
            std::size_t size);
+  bool image(const std::string& device, const ImageSample& sample);
   bool status(const device_status_t& status);
 
  private:

@@ -1,16 +1,18 @@
 // The fiducial driver on rendered image sequences: poses near the truth with finite
-// covariances, decodable raw detections, and clear errors for a missing camera, an
-// unreadable calibration and a corrupt video.
+// covariances, decodable raw detections, the frames themselves when asked (publish_images),
+// and clear errors for a missing camera, an unreadable calibration and a corrupt video.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
 #include <thread>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "covtrack/devices/fiducial/fiducial_config.hpp"
 #include "covtrack/devices/fiducial/fiducial_driver.hpp"
@@ -32,6 +34,7 @@ class Sink : public SampleSink {
     std::lock_guard l(m);
     raws.emplace_back(d, d + n);
   }
+  void image(const ImageSample& s) override { std::lock_guard l(m); images.push_back(s); }
   void count_error(const std::string&) override { ++errors; }
   void count_resync() override {}
   void count_drop() override {}
@@ -39,6 +42,7 @@ class Sink : public SampleSink {
   std::mutex m;
   std::vector<PoseSample> poses;
   std::vector<std::vector<std::uint8_t>> raws;
+  std::vector<ImageSample> images;
   int errors = 0;
 };
 
@@ -118,6 +122,50 @@ TEST(FiducialDriver, ReportsEachMappedTagNearItsTruthWithRawDetections) {
   EXPECT_FALSE(decode_raw_frame(sink.raws[0].data(), sink.raws[0].size() - 1).has_value());
 }
 
+TEST(FiducialDriver, PublishesNoImagesUnlessAsked) {
+  const Scene s = render_sequence("noimages", 2);
+  Sink sink;
+  auto r = run_driver(config_for(s), sink, 2);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  EXPECT_TRUE(sink.images.empty());
+}
+
+// Every n-th frame goes out as a JPEG stamped like that frame's poses, so a view of the
+// log puts each picture behind the regions measured in it.
+TEST(FiducialDriver, PublishesEveryNthFrameWithItsPosesTime) {
+  const Scene s = render_sequence("images", 6);
+  FiducialConfig c = config_for(s);
+  c.publish_images = true;
+  c.image_every_n = 2;
+  Sink sink;
+  auto r = run_driver(c, sink, 6);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  ASSERT_EQ(sink.raws.size(), 6u);
+  std::set<std::int64_t> frame_times;
+  for (const PoseSample& p : sink.poses) frame_times.insert(p.measurement_time_us);
+  ASSERT_EQ(frame_times.size(), 6u);  // one time per frame
+  const std::vector<std::int64_t> times(frame_times.begin(), frame_times.end());
+  ASSERT_EQ(sink.images.size(), 3u);
+  const CameraModel cam = test::small_camera();
+  for (std::size_t i = 0; i < sink.images.size(); ++i) {
+    const ImageSample& image = sink.images[i];
+    EXPECT_EQ(image.measurement_time_us, times[2 * i]) << "image " << i;
+    EXPECT_EQ(image.encoding, "jpeg");
+    EXPECT_EQ(image.width, cam.width_px);
+    EXPECT_EQ(image.height, cam.height_px);
+    const cv::Mat decoded = cv::imdecode(image.bytes, cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(decoded.empty()) << "image " << i << " does not decode";
+    EXPECT_EQ(decoded.cols, cam.width_px);
+    EXPECT_EQ(decoded.rows, cam.height_px);
+  }
+  // The picture is the rendered scene, JPEG-compressed (mean error 2.2 grey levels here;
+  // a differently noised frame of the same scene is 2.9: the times above tell frames apart).
+  cv::Mat frame = cv::imread((s.dir / "frame_0000.png").string(), cv::IMREAD_GRAYSCALE);
+  cv::Mat first = cv::imdecode(sink.images[0].bytes, cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(first.size(), frame.size());
+  EXPECT_LT(cv::norm(first, frame, cv::NORM_L1) / double(frame.total()), 4.0);
+}
+
 TEST(FiducialDriver, MissingCameraIsAClearError) {
   const Scene s = render_sequence("cam", 1);
   FiducialConfig c = config_for(s);
@@ -168,4 +216,32 @@ TEST(FiducialDriver, ConfigErrorsNameTheKey) {
   const std::string all = errors.joined();
   EXPECT_NE(all.find("unknown AprilTag family 'tag99'"), std::string::npos) << all;
   EXPECT_NE(all.find("devices.cam.tags"), std::string::npos) << all;
+}
+
+TEST(FiducialDriver, ImageOptionErrorsNameTheKey) {
+  auto toml = parse_toml("type = \"fiducial\"\nsource = \"x.png\"\ncalibration = \"c.yml\"\n"
+                         "publish_images = \"yes\"\nimage_every_n = 0\nimage_jpeg_quality = 101\n"
+                         "[[tags]]\nid = 1\nsize_m = 0.1\n", "test.toml");
+  ASSERT_TRUE(toml.has_value());
+  ConfigErrors errors;
+  TableReader r(*toml, "devices.cam", fiducial_device_spec(), "dir/test.toml", errors);
+  const FiducialConfig c = read_fiducial_config(r, "cam");
+  const std::string all = errors.joined();
+  EXPECT_NE(all.find("devices.cam.publish_images"), std::string::npos) << all;
+  EXPECT_NE(all.find("devices.cam.image_every_n"), std::string::npos) << all;
+  EXPECT_NE(all.find("devices.cam.image_jpeg_quality"), std::string::npos) << all;
+  EXPECT_EQ(errors.list().size(), 3u) << all;
+  EXPECT_GE(c.image_every_n, 1);  // a usable value even when the key is wrong
+
+  auto good = parse_toml("type = \"fiducial\"\nsource = \"x.png\"\ncalibration = \"c.yml\"\n"
+                         "publish_images = true\nimage_every_n = 5\nimage_jpeg_quality = 60\n"
+                         "[[tags]]\nid = 1\nsize_m = 0.1\n", "test.toml");
+  ASSERT_TRUE(good.has_value());
+  ConfigErrors none;
+  TableReader g(*good, "devices.cam", fiducial_device_spec(), "dir/test.toml", none);
+  const FiducialConfig d = read_fiducial_config(g, "cam");
+  EXPECT_TRUE(none.empty()) << none.joined();
+  EXPECT_TRUE(d.publish_images);
+  EXPECT_EQ(d.image_every_n, 5);
+  EXPECT_EQ(d.image_jpeg_quality, 60);
 }

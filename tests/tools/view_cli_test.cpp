@@ -1,6 +1,7 @@
 // `covtrack view` as a user runs it: headless pictures checked pixel by pixel against the
-// regions `covtrack regions --json` reports, a video, a broken background, no display, and
-// live streams (published by this test inside its private network namespace).
+// regions `covtrack regions --json` reports, a video, a broken background, no display,
+// live streams (published by this test inside its private network namespace), and a
+// recorded session's camera frames behind the regions.
 #include <algorithm>
 #include <array>
 #include <cstdlib>
@@ -19,6 +20,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include <covtrack/image_t.hpp>
 #include <covtrack/pose_cov_t.hpp>
 
 #include "covtrack/lcmlog/log_writer.hpp"
@@ -241,6 +243,91 @@ TEST(ViewCli, LogIsFollowedAtItsOwnTime) {
   const CliRun missing = run("view " + scene.string() + " --log /nonexistent/session.lcm --png /tmp/x.png");
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.out.find("/nonexistent/session.lcm"), std::string::npos) << missing.out;
+  std::filesystem::remove(log_path);
+  std::filesystem::remove(scene);
+}
+
+namespace {
+
+// A solid-colour camera frame as the fiducial driver publishes it (smaller than the view,
+// so the view must scale it).
+covtrack::image_t solid_image(const cv::Vec3b& bgr, const std::string& encoding) {
+  const cv::Mat frame(240, 320, CV_8UC3, cv::Scalar(bgr[0], bgr[1], bgr[2]));
+  covtrack::image_t m{};
+  m.device = "viewtest";
+  m.width = frame.cols;
+  m.height = frame.rows;
+  m.encoding = encoding;
+  EXPECT_TRUE(cv::imencode(encoding == "png" ? ".png" : ".jpg", frame, m.data));
+  m.size = static_cast<std::int32_t>(m.data.size());
+  return m;
+}
+
+template <typename Msg>
+void write_event(covtrack::lcmlog::LogWriter& log, std::int64_t t, const std::string& channel, Msg m) {
+  std::vector<std::byte> bytes(m.getEncodedSize());
+  m.encode(bytes.data(), 0, int(bytes.size()));
+  ASSERT_TRUE(log.write(t, channel, bytes));
+}
+
+// Pixels far from the object and the legend: where only the background shows.
+bool background_is(const cv::Mat& image, const cv::Vec3b& bgr) {
+  for (const cv::Point p : {cv::Point(630, 10), cv::Point(630, 240), cv::Point(500, 120)}) {
+    const cv::Vec3b v = image.at<cv::Vec3b>(p);
+    for (int c = 0; c < 3; ++c)
+      if (std::abs(int(v[c]) - int(bgr[c])) > 6) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+// A session with camera frames: the view draws the latest frame at or before the log time
+// behind the regions; a corrupt frame is reported and skipped; --background still wins.
+TEST(ViewCli, LogCameraFramesAreTheBackground) {
+  const std::filesystem::path scene = write_thing_scene();
+  const std::string log_path = (kTmp / "covtrack_view_images.lcm").string();
+  const cv::Vec3b first(200, 30, 30), second(30, 160, 220);
+  const std::int64_t t0 = 1'700'000'000'000'000;
+  {
+    auto log = covtrack::lcmlog::LogWriter::create(log_path, true);
+    ASSERT_TRUE(log) << log.error().message;
+    const std::string image_channel = covtrack::image_channel("viewtest");
+    for (int i = 0; i < 300; ++i) {  // 6 s of reports
+      const std::int64_t t = t0 + i * 20'000;
+      write_event(*log, t, covtrack::pose_channel("viewtest", "thing"), thing_message(i, t, false));
+      if (i == 0) write_event(*log, t, image_channel, solid_image(first, "png"));
+      if (i == 100) {  // at 2 s: a frame whose bytes are no JPEG
+        covtrack::image_t bad = solid_image(second, "jpeg");
+        std::fill(bad.data.begin(), bad.data.end(), 0x55);
+        write_event(*log, t, image_channel, bad);
+      }
+      if (i == 200) write_event(*log, t, image_channel, solid_image(second, "jpeg"));  // at 4 s
+    }
+  }
+  const std::string png = (kTmp / "covtrack_view_images.png").string();
+  const auto picture = [&](const std::string& timing, std::string* out = nullptr) {
+    const CliRun r = run("view " + scene.string() + " --log " + log_path + " " + timing + " --png " + png);
+    EXPECT_EQ(r.exit_code, 0) << r.out;
+    if (out) *out = r.out;
+    cv::Mat image = cv::imread(png, cv::IMREAD_COLOR);
+    std::filesystem::remove(png);
+    return image;
+  };
+  const cv::Mat at_half_second = picture("--duration 0.5");
+  std::string corrupt_out;
+  const cv::Mat at_3s = picture("--duration 1.5 --speed 2", &corrupt_out);
+  const cv::Mat at_end = picture("--duration 2 --speed 20");
+  const cv::Mat overridden = picture("--duration 2 --speed 20 --background \"#00ff00\"");
+  ASSERT_FALSE(at_half_second.empty());
+  ASSERT_FALSE(at_3s.empty());
+  ASSERT_FALSE(at_end.empty());
+  ASSERT_FALSE(overridden.empty());
+  EXPECT_TRUE(background_is(at_half_second, first)) << at_half_second.at<cv::Vec3b>(10, 630);
+  EXPECT_TRUE(background_is(at_3s, first)) << at_3s.at<cv::Vec3b>(10, 630);  // the corrupt one skipped
+  EXPECT_NE(corrupt_out.find("skipped"), std::string::npos) << corrupt_out;
+  EXPECT_TRUE(background_is(at_end, second)) << at_end.at<cv::Vec3b>(10, 630);
+  EXPECT_TRUE(background_is(overridden, cv::Vec3b(0, 255, 0))) << overridden.at<cv::Vec3b>(10, 630);
   std::filesystem::remove(log_path);
   std::filesystem::remove(scene);
 }

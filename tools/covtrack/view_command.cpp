@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <opencv2/highgui.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include <fmt/format.h>
@@ -67,6 +68,14 @@ std::vector<std::string> legend_lines(const RegionsModel& model, const LatestRep
     lines.push_back(fmt::format("{} -> {} [{}]: {}", t.parent, t.child, t.stream->key(), state));
   }
   return lines;
+}
+
+// A recorded camera frame as the view's background: the view's size, a copy to draw on.
+cv::Mat fitted_to(const cv::Mat& frame, cv::Size size) {
+  if (frame.size() == size) return frame.clone();
+  cv::Mat out;
+  cv::resize(frame, out, size);
+  return out;
 }
 
 // What the pointer does now, for the legend.
@@ -170,7 +179,11 @@ int run_view(const ViewArgs& args) {
     // --png takes its one frame at the end of --duration (live streams have arrived by then).
     if (!args.png_path.empty() && !last && duration_s > 0) continue;
 
-    cv::Mat image = background.next(warning);
+    // A log's own camera frames are the background unless --background names another.
+    cv::Mat image;
+    if (log && args.background.empty())
+      if (const cv::Mat& frame = log->image(warning); !frame.empty()) image = fitted_to(frame, size);
+    if (image.empty()) image = background.next(warning);
     if (!warning.empty()) {
       std::cerr << "covtrack view: " << warning << "\n";
       warning.clear();
@@ -208,7 +221,8 @@ void add_view_command(CLI::App& app) {
   cmd->add_option("--png", args->png_path, "Write one frame (at the end of --duration, if given) and exit");
   cmd->add_option("--video", args->video_path, "Write the frames to this video file (MJPG AVI)");
   cmd->add_option("--background", args->background,
-                  "#rrggbb, an image file, a video file (looped) or camera:N");
+                  "#rrggbb, an image file, a video file (looped) or camera:N (default with --log: the "
+                  "log's camera frames, if it has any)");
   cmd->add_option("--duration", args->duration_s,
                   "Seconds to run (default: until q/Esc/Ctrl-C; 10 for --video); offline (no --live, no --log) "
                   "into a file, scene seconds rendered without waiting")

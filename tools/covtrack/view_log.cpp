@@ -1,7 +1,9 @@
 #include "view_log.hpp"
 
 #include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
 
+#include <covtrack/image_t.hpp>
 #include <covtrack/pose_cov_t.hpp>
 
 #include "covtrack/client/pose_validation.hpp"
@@ -27,6 +29,7 @@ void LogFollower::advance_to(std::int64_t log_time_us, client::TransformGraph& g
 }
 
 void LogFollower::feed(const lcmlog::LogEvent& event, client::TransformGraph& graph) {
+  if (event.channel.starts_with(kImagePrefix)) return keep_image(event);
   const auto stream = parse_pose_channel(event.channel);
   if (!stream) return;  // raw bytes, truth, heartbeats: not for the view
   pose_cov_t msg;
@@ -42,6 +45,54 @@ void LogFollower::feed(const lcmlog::LogEvent& event, client::TransformGraph& gr
   }
   latest_[t.stream.key()] = t;
   (void)graph.update(t.stream, t);  // streams the scene does not use are not in the graph
+}
+
+// Kept encoded: most frames of a fast replay are overtaken before they are drawn.
+void LogFollower::keep_image(const lcmlog::LogEvent& event) {
+  const std::string_view device = event.channel.substr(kImagePrefix.size());
+  if (image_device_.empty()) image_device_ = device;
+  if (device != image_device_) return;
+  const auto* bytes = reinterpret_cast<const std::uint8_t*>(event.payload.data());
+  undrawn_.push_back({{bytes, bytes + event.payload.size()}, event.timestamp_us});
+  if (undrawn_.size() > kKeptImages) undrawn_.pop_front();
+}
+
+const cv::Mat& LogFollower::image(std::string& warning) {
+  while (!undrawn_.empty()) {
+    const EncodedImage newest = std::move(undrawn_.back());
+    undrawn_.pop_back();
+    if (decode_image(newest.payload, newest.time_us, warning)) {
+      undrawn_.clear();  // older than what is now shown
+      break;
+    }
+  }
+  return image_;
+}
+
+bool LogFollower::decode_image(const std::vector<std::uint8_t>& payload, std::int64_t time_us,
+                               std::string& warning) {
+  const auto corrupt = [&](const std::string& why) {
+    ++corrupt_images_;
+    warning = fmt::format("image from '{}' at log time {} us skipped: {}", image_device_, time_us, why);
+    return false;
+  };
+  image_t msg;
+  const int size = static_cast<int>(payload.size());
+  if (msg.decode(payload.data(), 0, size) != size) return corrupt("not a valid image_t message");
+  if (msg.encoding != "jpeg" && msg.encoding != "png")
+    return corrupt(fmt::format("encoding '{}' is neither jpeg nor png", msg.encoding));
+  cv::Mat decoded;
+  try {
+    decoded = cv::imdecode(msg.data, cv::IMREAD_COLOR);
+  } catch (const cv::Exception& e) {  // some codecs throw on damaged data instead of failing
+    return corrupt(e.what());
+  }
+  if (decoded.empty()) return corrupt(fmt::format("{} data does not decode", msg.encoding));
+  if (decoded.cols != msg.width || decoded.rows != msg.height)
+    return corrupt(fmt::format("decodes to {}x{}, the message says {}x{}", decoded.cols, decoded.rows,
+                               msg.width, msg.height));
+  image_ = decoded;
+  return true;
 }
 
 std::optional<client::TrackedTransform> LogFollower::latest(const StreamId& id) const {

@@ -37,6 +37,13 @@ const TableSpec& fiducial_device_spec() {
         {"loop", ValueType::Boolean, "", "true", "files: start over at the end"},
         {"publish_raw", ValueType::Boolean, "", "true", "publish detections on covtrack/raw/<name> "
          "(format: devices/fiducial/README.md)"},
+        {"publish_images", ValueType::Boolean, "", "false", "publish the frames detected on, as JPEG, on "
+         "covtrack/image/<name> with their poses' measurement time (a recorded session then shows "
+         "the camera's picture in `covtrack view --log`)"},
+        {"image_every_n", ValueType::Integer, "", "1", "publish_images: one image per this many "
+         "frames", 1, 10000},
+        {"image_jpeg_quality", ValueType::Integer, "", "80", "publish_images: JPEG quality (higher: "
+         "larger, sharper)", 1, 100},
         {"tags", ValueType::TableArray, "", "", "the tag map: [[devices.<name>.tags]]; tags not "
          "listed are ignored"},
     };
@@ -95,6 +102,9 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
   c.rate_hz = r.number("rate_hz", 30);
   c.loop = r.boolean("loop", true);
   c.publish_raw = r.boolean("publish_raw", true);
+  c.publish_images = r.boolean("publish_images", false);
+  c.image_every_n = static_cast<int>(r.integer("image_every_n", 1));
+  c.image_jpeg_quality = static_cast<int>(r.integer("image_jpeg_quality", 80));
   for (const toml::table* t : r.tables("tags")) {
     TableReader tr(*t, r.path("tags"), fiducial_tag_spec(), r.file(), r.errors());
     const int id = static_cast<int>(tr.integer("id", 0));

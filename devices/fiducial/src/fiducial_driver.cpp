@@ -1,10 +1,12 @@
 #include "covtrack/devices/fiducial/fiducial_driver.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <limits>
 #include <set>
 
 #include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -91,6 +93,8 @@ class FiducialDriver final : public Driver {
                                 config_.source, gray.cols, gray.rows, config_.calibration,
                                 camera_.width_px, camera_.height_px));
       process(sink, gray, index, time_us);
+      if (config_.publish_images && frames_published_++ % std::max(1, config_.image_every_n) == 0)
+        publish_image(sink, frame, time_us);
     }
     return {};
   }
@@ -141,11 +145,26 @@ class FiducialDriver final : public Driver {
     }
   }
 
+  // The frame as captured (colour if it is), after its poses: a see-through view of the
+  // log finds the picture at the same measurement time as the poses measured in it.
+  void publish_image(SampleSink& sink, const cv::Mat& frame, std::int64_t time_us) {
+    ImageSample image{time_us, frame.cols, frame.rows, "jpeg", {}};
+    const std::vector<int> params = {cv::IMWRITE_JPEG_QUALITY, config_.image_jpeg_quality};
+    cv::Mat eight_bit = frame;  // JPEG holds 8 bits per channel; deeper frames as the detector sees them
+    if (frame.depth() != CV_8U) frame.convertTo(eight_bit, CV_8U);
+    if (!cv::imencode(".jpg", eight_bit, image.bytes, params)) {
+      sink.count_error(fmt::format("frame {}x{}: JPEG encoding failed", frame.cols, frame.rows));
+      return;
+    }
+    sink.image(image);
+  }
+
   FiducialConfig config_;
   CameraModel camera_;
   std::unique_ptr<TagDetector> detector_;
   std::unique_ptr<cv::VideoCapture> capture_;
   bool is_camera_ = false;
+  std::uint64_t frames_published_ = 0;  // frames considered for publish_images (every n-th goes)
   std::map<int, Pose> last_pose_;
 };
 

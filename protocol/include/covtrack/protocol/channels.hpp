@@ -10,6 +10,7 @@ inline constexpr std::string_view kPosePrefix = "covtrack/pose/";
 inline constexpr std::string_view kTruthPrefix = "covtrack/truth/";
 inline constexpr std::string_view kStatusPrefix = "covtrack/status/";
 inline constexpr std::string_view kRawPrefix = "covtrack/raw/";
+inline constexpr std::string_view kImagePrefix = "covtrack/image/";
 
 // LCM limits channel names to 63 characters; with the longest prefix and a '/',
 // device and sensor names of at most 23 characters each always fit.
@@ -22,6 +23,7 @@ std::string pose_channel(std::string_view device, std::string_view sensor);
 std::string truth_channel(std::string_view device, std::string_view sensor);
 std::string status_channel(std::string_view device);
 std::string raw_channel(std::string_view device);
+std::string image_channel(std::string_view device);
 
 struct StreamId {
   std::string device;

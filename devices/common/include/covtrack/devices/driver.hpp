@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <stop_token>
 #include <string>
+#include <vector>
 
 #include "covtrack/protocol/pose_message.hpp"
 #include "covtrack/protocol/result.hpp"
@@ -31,6 +32,16 @@ struct TruthSample {
   Pose T_parent_child = Pose::Identity();
 };
 
+// A camera frame as a whole compressed file (protocol/lcmtypes/image_t.lcm), with the
+// measurement time of the poses measured in it.
+struct ImageSample {
+  std::int64_t measurement_time_us = 0;
+  int width = 0;
+  int height = 0;
+  std::string encoding;  // "jpeg" or "png"
+  std::vector<std::uint8_t> bytes;
+};
+
 enum class ByteDirection : std::int8_t { FromDevice = 0, ToDevice = 1 };
 
 // Everything a driver reports. Calls come from the driver's own thread only.
@@ -40,6 +51,8 @@ class SampleSink {
   virtual void pose(const PoseSample& sample) = 0;
   virtual void truth(const TruthSample& sample) = 0;
   virtual void raw(ByteDirection direction, const std::uint8_t* data, std::size_t size) = 0;
+  // Camera frames are optional: a sink that has no use for them drops them.
+  virtual void image(const ImageSample&) {}
   // Bad frames skipped by a decoder, resynchronisations, data the driver had to drop.
   virtual void count_error(const std::string& what) = 0;
   virtual void count_resync() = 0;

@@ -21,6 +21,9 @@ struct FiducialConfig {
   double rate_hz = 30;         // files: replay pace (0: as fast as possible); cameras: ignored
   bool loop = true;            // files: start over at the end
   bool publish_raw = true;
+  bool publish_images = false;  // the frames themselves, for a see-through view of a log
+  int image_every_n = 1;        // one image per this many frames
+  int image_jpeg_quality = 80;
   std::map<int, double> tag_size_m;  // the tag map: id -> edge of the detected square
 };
 
