@@ -12,6 +12,8 @@
 #include <string>
 #include <thread>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
@@ -35,7 +37,13 @@ namespace {
 CliRun run(const std::string& args, const std::string& env = "") { return run_covtrack(args, env); }
 
 const std::string kScene = COVTRACK_SOURCE_DIR "/config/scenes/head_and_world.toml";
-const std::filesystem::path kTmp = std::filesystem::temp_directory_path();
+// One folder per test process: two checkouts running this test at once (a shared
+// machine) would otherwise delete each other's scene and log files.
+const std::filesystem::path kTmp = [] {
+  const auto dir = std::filesystem::temp_directory_path() / ("covtrack_view_cli_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir;
+}();
 
 struct PixelCounts {
   int green = 0;         // outer-region pixels
