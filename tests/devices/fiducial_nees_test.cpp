@@ -3,6 +3,7 @@
 // (different poses, tag sizes, noise, contrast and blur), pooled and per view.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -34,17 +35,20 @@ CalibrationView view(int id, double size_m, double distance_m, double yaw, doubl
   return v;
 }
 
-// Calibration views: their own sizes, distances and looks, none shared with validation.
+// Calibration views: their own sizes, distances, yaws and looks, none shared with
+// validation but spanning its ranges (tag edge 25-70 px, quiet band 4-14 px, yaw 4-61 deg).
 std::vector<CalibrationView> calibration_views() {
   std::vector<CalibrationView> v;
-  const double sizes[] = {0.12, 0.2};
+  const double sizes[] = {0.10, 0.12, 0.2, 0.25};
   const double noises[] = {1.5, 3, 5, 7, 10, 2.5};
   for (int i = 0; i < 18; ++i) {
-    const double size = sizes[i % 2];
-    const double distance = size * (4 + 1.5 * (i % 5));
+    const double size = sizes[i % 4];
+    const double yaw = std::fmod(4 + 17 * i, 62);
+    // Steep views come nearer, so that every view is detected (none wasted).
+    const double distance = size * (5 + 1.5 * (yaw > 40 ? i % 3 : i % 5));
     // Every third view has its edges along the pixel axes (roll 0 or 90 degrees).
     const double roll = i % 3 == 0 ? 90.0 * (i % 2) : 13.0 * i;
-    v.push_back(view(i, size, distance, 5 + 4.5 * i, (i % 3 - 1) * 9.0, roll, 0.02 * (i % 3 - 1),
+    v.push_back(view(i, size, distance, yaw, (i % 3 - 1) * 9.0, roll, 0.02 * (i % 3 - 1),
                      -0.015 * (i % 2), noises[i % 6], 25 + 7 * (i % 4), 200 + 5 * (i % 5),
                      0.6 + 0.1 * (i % 6)));
   }
@@ -75,22 +79,34 @@ struct ViewNees {
   double mean_nees = 0;
   int detected = 0, ambiguous = 0;
   double sigma_px = 0, rms_corner_px = 0, edge_px = 0;
+  double band_px = 0;               // narrowest quiet band beyond an edge (mean over draws)
+  double bias_px = 0, spread_px = 0;  // rms over the 8 coordinates of the corner error's mean / sd
 };
+
 
 ViewNees nees_of(const CameraModel& cam, const CalibrationView& v, const std::vector<ViewDraw>& draws,
                  const CornerNoiseModel& model) {
   ViewNees out;
   double sum = 0, sq = 0;
+  Eigen::Matrix<double, 8, 1> e_sum = Eigen::Matrix<double, 8, 1>::Zero(), e_sq = e_sum;
   for (const ViewDraw& d : draws) {
     if (!d.detection) continue;
+    const auto truth = projected_corners(cam, {v.tag.id, v.tag.size_m, d.T_camera_tag_true});
+    for (int k = 0; k < 4; ++k) {
+      const cv::Point2d err = d.detection->corners_px[k] - truth[k];
+      e_sum(2 * k) += err.x, e_sum(2 * k + 1) += err.y;
+      e_sq(2 * k) += err.x * err.x, e_sq(2 * k + 1) += err.y * err.y;
+    }
+    out.band_px += *std::min_element(d.corner_band_px.begin(), d.corner_band_px.end());
     const CornerNoise noise = corner_noise(model, d);
-    const double sigma = noise.sigma_px;
+    double variance = noise.sigma_px * noise.sigma_px;  // the corners' mean, narrow term included
+    for (double extra : noise.narrow_px) variance += extra * extra / 4;
     auto pose = estimate_tag_pose(cam, d.detection->corners_px, v.tag.size_m, noise);
     if (!pose) continue;
     const Vec6 e = boxminus(d.T_camera_tag_true, pose->best.T_camera_tag);
     sum += e.dot(pose->covariance.ldlt().solve(e));
     sq += d.corner_sq_error_px2;
-    out.sigma_px += sigma;
+    out.sigma_px += std::sqrt(variance);
     out.edge_px += d.edge_length_px;
     out.ambiguous += pose->ambiguous;
     ++out.detected;
@@ -99,6 +115,11 @@ ViewNees nees_of(const CameraModel& cam, const CalibrationView& v, const std::ve
     out.mean_nees = sum / out.detected;
     out.sigma_px /= out.detected, out.edge_px /= out.detected;
     out.rms_corner_px = std::sqrt(sq / out.detected);
+    out.band_px /= out.detected;
+    const Eigen::Matrix<double, 8, 1> mean = e_sum / out.detected;
+    const Eigen::Matrix<double, 8, 1> var = e_sq / out.detected - mean.cwiseProduct(mean);
+    out.bias_px = std::sqrt(mean.squaredNorm() / 8);
+    out.spread_px = std::sqrt(std::max(0.0, var.sum() / 8));
   }
   return out;
 }
@@ -114,15 +135,21 @@ TEST(FiducialNees, CalibratedCornerModelGivesHonestPoseCovariance) {
     ASSERT_TRUE(draws.has_value()) << draws.error().message;
     calibration.push_back(std::move(*draws));
   }
+  for (std::size_t i = 0; i < calibration.size(); ++i) {
+    const auto detected = std::count_if(calibration[i].begin(), calibration[i].end(),
+                                        [](const ViewDraw& d) { return d.detection.has_value(); });
+    EXPECT_GE(detected, kCalibrationDraws * 9 / 10) << "calibration view " << i << " is wasted";
+  }
   const CornerNoiseModel model = fit_corner_noise(cam, calibration_views(), calibration);
   std::printf("calibrated corner model: gain %.3f px, floor %.4f px, axis-aligned %.4f px, "
-              "radial bias %.4f px, radial sigma %.4f px\n",
-              model.gain_px, model.floor_px, model.aligned_px, model.radial_bias_px, model.radial_sigma_px);
+              "narrow %.4f px (power %.0f), radial bias %.4f px, radial sigma %.4f px\n",
+              model.gain_px, model.floor_px, model.aligned_px, model.narrow_px, model.narrow_power,
+              model.radial_bias_px, model.radial_sigma_px);
 
   double pooled_sum = 0;
   int pooled_n = 0, within_2x = 0;
-  std::printf("%5s %5s %5s %5s %6s %6s %7s %7s %5s %4s\n", "size", "dist", "yaw", "noise",
-              "edge", "sigma", "rmsCorn", "NEES", "det", "amb");
+  std::printf("%4s %5s %5s %5s %5s %6s %5s %6s %7s %6s %6s %7s %5s %4s\n", "view", "size", "dist",
+              "yaw", "noise", "edge", "band", "sigma", "rmsCorn", "bias", "spread", "NEES", "det", "amb");
   const auto views = validation_views();
   for (std::size_t i = 0; i < views.size(); ++i) {
     const auto& v = views[i];
@@ -130,14 +157,15 @@ TEST(FiducialNees, CalibratedCornerModelGivesHonestPoseCovariance) {
     ASSERT_TRUE(draws.has_value()) << draws.error().message;
     const ViewNees n = nees_of(cam, v, *draws, model);
     const double yaw = std::atan2(-v.tag.T_camera_tag.rotation()(2, 0), v.tag.T_camera_tag.rotation()(2, 2));
-    std::printf("%5.2f %5.2f %5.0f %5.1f %6.1f %6.3f %7.3f %7.2f %5d %4d\n", v.tag.size_m,
-                v.tag.T_camera_tag.translation().z(), yaw * 180 / M_PI, v.noise_sigma, n.edge_px,
-                n.sigma_px, n.rms_corner_px, n.mean_nees, n.detected, n.ambiguous);
+    std::printf("%4zu %5.2f %5.2f %5.0f %5.1f %6.1f %5.1f %6.3f %7.3f %6.3f %6.3f %7.2f %5d %4d\n", i,
+                v.tag.size_m, v.tag.T_camera_tag.translation().z(), yaw * 180 / M_PI, v.noise_sigma,
+                n.edge_px, n.band_px, n.sigma_px, n.rms_corner_px, n.bias_px, n.spread_px,
+                n.mean_nees, n.detected, n.ambiguous);
     EXPECT_GE(n.detected, kValidationDraws * 9 / 10) << "view " << i;
-    // The bar is 2x (NEES in [3, 12]) for every view; it is not met yet (about
-    // half the views; see devices/fiducial/README.md, "Limits"). Held here: no view 10x off.
-    EXPECT_LT(n.mean_nees, 60.0) << "view " << i << " is over 10x over-confident";
-    EXPECT_GT(n.mean_nees, 0.6) << "view " << i << " is over 10x under-confident";
+    // The bar is 2x (NEES in [3, 12]) for every view; held: every view within 4x
+    // and all but three within 2x (devices/fiducial/README.md, "Limits").
+    EXPECT_LT(n.mean_nees, 24.0) << "view " << i << " is over 4x over-confident";
+    EXPECT_GT(n.mean_nees, 1.5) << "view " << i << " is over 4x under-confident";
     within_2x += n.mean_nees >= 3.0 && n.mean_nees <= 12.0;
     pooled_sum += n.mean_nees * n.detected;
     pooled_n += n.detected;
@@ -148,9 +176,8 @@ TEST(FiducialNees, CalibratedCornerModelGivesHonestPoseCovariance) {
   std::printf("pooled mean NEES %.3f over %d draws; chi2(6) 99%% bounds [%.3f, %.3f]\n", pooled,
               pooled_n, 6 - half_width, 6 + half_width);
   std::printf("views within 2x (mean NEES in [3, 12]): %d of %zu\n", within_2x, views.size());
-  // Held: the pooled mean within 15% of 6 and most views within 2x. The chi-square
-  // bounds above are the bar, printed for the record.
-  EXPECT_GT(pooled, 6 * 0.85);
-  EXPECT_LT(pooled, 6 * 1.15);
-  EXPECT_GE(within_2x, static_cast<int>(views.size()) / 2);
+  // The bar for the pooled set.
+  EXPECT_GT(pooled, 6 - half_width);
+  EXPECT_LT(pooled, 6 + half_width);
+  EXPECT_GE(within_2x, static_cast<int>(views.size()) - 3);
 }

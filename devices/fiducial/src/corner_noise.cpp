@@ -4,6 +4,8 @@
 #include <cmath>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
 namespace covtrack::fiducial {
 
 double CornerNoiseModel::noise_term(double image_noise, double contrast, double edge_length_px) {
@@ -16,6 +18,13 @@ double CornerNoiseModel::sigma_px(double image_noise, double contrast, double ed
   return std::sqrt(floor_px * floor_px +
                    gain_px * gain_px * noise_term(image_noise, contrast, edge_length_px) +
                    aligned_px * aligned_px * axis_alignment);
+}
+
+double CornerNoiseModel::narrow_sigma_px(double quiet_band_px) const {
+  if (narrow_px <= 0) return 0;
+  // A degenerate quad (NaN band) counts as the narrowest band: never less variance.
+  const double band = quiet_band_px > 0.5 ? quiet_band_px : 0.5;
+  return narrow_px * std::pow(kNarrowBandPx / band, narrow_power / 2);
 }
 
 double estimate_image_noise(const cv::Mat& gray) {
@@ -95,6 +104,33 @@ double mean_edge_length_px(const std::array<cv::Point2d, 4>& c) {
   double sum = 0;
   for (int e = 0; e < 4; ++e) sum += std::hypot(c[(e + 1) % 4].x - c[e].x, c[(e + 1) % 4].y - c[e].y);
   return sum / 4;
+}
+
+std::array<double, 4> quiet_band_px(const std::array<cv::Point2d, 4>& c, int cells_across_border,
+                                    double quiet_cells) {
+  // The detected square as [-1, 1]^2 in AprilTag's corner order; a cell is 2 / cells wide.
+  const cv::Point2f plane[4] = {{-1, 1}, {1, 1}, {1, -1}, {-1, -1}};
+  const cv::Point2f image[4] = {c[0], c[1], c[2], c[3]};
+  const cv::Matx33d H(cv::getPerspectiveTransform(plane, image));
+  const double out = 1 + 2 * quiet_cells / std::max(cells_across_border, 1);
+  std::array<double, 4> band{};
+  for (int e = 0; e < 4; ++e) {
+    const cv::Point2d a = c[e], b = c[(e + 1) % 4];
+    const cv::Vec3d m = H * cv::Vec3d(out * (plane[e].x + plane[(e + 1) % 4].x) / 2,
+                                      out * (plane[e].y + plane[(e + 1) % 4].y) / 2, 1);
+    const cv::Point2d p(m[0] / m[2], m[1] / m[2]);
+    const double length = std::max(std::hypot(b.x - a.x, b.y - a.y), 1e-9);
+    band[static_cast<std::size_t>(e)] = std::abs((b - a).cross(p - a)) / length;
+  }
+  return band;
+}
+
+std::array<double, 4> corner_quiet_band_px(const std::array<cv::Point2d, 4>& c,
+                                           int cells_across_border, double quiet_cells) {
+  const auto edge = quiet_band_px(c, cells_across_border, quiet_cells);
+  std::array<double, 4> corner{};
+  for (std::size_t k = 0; k < 4; ++k) corner[k] = std::min(edge[(k + 3) % 4], edge[k]);
+  return corner;
 }
 
 }  // namespace covtrack::fiducial

@@ -57,6 +57,7 @@ class FiducialDriver final : public Driver {
     auto detector = TagDetector::create(config_.detector);
     if (!detector) return std::unexpected(detector.error());
     detector_ = std::move(*detector);
+    quiet_cells_ = detector_->family().quiet_cells(config_.paper_margin_cells);
     if (auto opened = open_source(); !opened) return opened;
 
     using namespace std::chrono;
@@ -110,7 +111,9 @@ class FiducialDriver final : public Driver {
       const double sigma = config_.noise.sigma_px(raw.image_noise, contrast,
                                                   mean_edge_length_px(det.corners_px),
                                                   edge_axis_alignment(det.corners_px));
-      const CornerNoise noise{sigma, config_.noise.radial_bias_px, config_.noise.radial_sigma_px};
+      CornerNoise noise{sigma, config_.noise.radial_bias_px, config_.noise.radial_sigma_px, {}};
+      const auto band = corner_quiet_band_px(det.corners_px, cells, quiet_cells_);
+      for (std::size_t k = 0; k < 4; ++k) noise.narrow_px[k] = config_.noise.narrow_sigma_px(band[k]);
       auto pose = estimate_tag_pose(camera_, det.corners_px, size->second, noise, config_.ambiguity_chi2);
       if (!pose) {
         sink.count_error(fmt::format("tag {}: {}", det.id, pose.error().message));
@@ -165,6 +168,7 @@ class FiducialDriver final : public Driver {
   std::unique_ptr<cv::VideoCapture> capture_;
   bool is_camera_ = false;
   std::uint64_t frames_published_ = 0;  // frames considered for publish_images (every n-th goes)
+  double quiet_cells_ = 2;  // uniform cells beyond the detected square's edges
   std::map<int, Pose> last_pose_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <thread>
 
 #include <Eigen/Dense>
@@ -44,8 +45,11 @@ ViewDraw one_draw(const CameraModel& camera, TagDetector& detector, const Calibr
   }
   for (int k = 0; k < 4; ++k) {
     const cv::Point2d e = error[k] - d.radial_error_px * radial[k];
+    d.corner_sq_errors_px2[static_cast<std::size_t>(k)] = e.dot(e);
     d.corner_sq_error_px2 += e.dot(e) / 8;
   }
+  d.corner_band_px = corner_quiet_band_px(c, detector.family().cells_across_border(),
+                                          detector.family().quiet_cells(view.look.margin_cells));
   return d;
 }
 
@@ -75,8 +79,10 @@ Result<std::vector<ViewDraw>> draw_view(const CameraModel& camera, const Detecto
 }
 
 CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& d) {
-  return {model.sigma_px(d.image_noise, d.contrast, d.edge_length_px, d.axis_alignment),
-          model.radial_bias_px, model.radial_sigma_px};
+  CornerNoise n{model.sigma_px(d.image_noise, d.contrast, d.edge_length_px, d.axis_alignment),
+                model.radial_bias_px, model.radial_sigma_px, {}};
+  for (std::size_t k = 0; k < 4; ++k) n.narrow_px[k] = model.narrow_sigma_px(d.corner_band_px[k]);
+  return n;
 }
 
 double mean_pose_nees(const CameraModel& camera, const CalibrationView& view,
@@ -98,43 +104,54 @@ double mean_pose_nees(const CameraModel& camera, const CalibrationView& view,
 
 namespace {
 
-using Vec3 = Eigen::Vector3d;
+using Vec4 = Eigen::Vector4d;
 
-// Per view: y = mean squared corner error, x = mean of each model term; y = sum c_k x_k,
-// solved for c_k >= 0 in relative least squares.
-Vec3 fit_terms(const std::vector<std::vector<ViewDraw>>& views) {
-  std::vector<Vec3> xs;
+// The narrow-band term's exponents tried (variance ~ band^-power).
+constexpr double kNarrowPowers[] = {2, 4, 6, 8, 10, 12};
+
+// The model's four variance terms for one corner of one draw: sigma^2 = c . terms.
+Vec4 terms_of(const CornerNoiseModel& shape, const ViewDraw& d, std::size_t corner) {
+  const double narrow = CornerNoiseModel{0, 0, 0, 0, 0, 1, shape.narrow_power}.narrow_sigma_px(
+      d.corner_band_px[corner]);
+  return {1, CornerNoiseModel::noise_term(d.image_noise, d.contrast, d.edge_length_px),
+          d.axis_alignment, narrow * narrow};
+}
+
+// A starting point: least squares of each view's mean squared corner error on the mean
+// terms, relative residuals; a negative coefficient is dropped.
+Vec4 initial_terms(const CornerNoiseModel& shape, const std::vector<std::vector<ViewDraw>>& views) {
+  std::vector<Vec4> xs;
   std::vector<double> ys;
   for (const auto& draws : views) {
-    Vec3 x = Vec3::Zero();
+    Vec4 x = Vec4::Zero();
     double y = 0;
     int n = 0;
     for (const ViewDraw& d : draws) {
       if (!d.detection) continue;
-      x += Vec3(1, CornerNoiseModel::noise_term(d.image_noise, d.contrast, d.edge_length_px),
-                d.axis_alignment);
+      for (std::size_t k = 0; k < 4; ++k) x += terms_of(shape, d, k) / 4;
       y += d.corner_sq_error_px2;
       ++n;
     }
     if (n) xs.push_back(x / n), ys.push_back(y / n);
   }
-  std::array<bool, 3> used{true, true, true};
-  Vec3 c = Vec3::Zero();
-  for (int round = 0; round < 3; ++round) {
+  std::array<bool, 4> used{true, true, true, true};
+  Vec4 c = Vec4::Zero();
+  for (int round = 0; round < 4; ++round) {
     std::vector<int> cols;
-    for (int k = 0; k < 3; ++k)
-      if (used[k]) cols.push_back(k);
+    for (int k = 0; k < 4; ++k)
+      if (used[static_cast<std::size_t>(k)]) cols.push_back(k);
     if (cols.empty() || xs.empty()) break;
     Eigen::MatrixXd A(static_cast<Eigen::Index>(xs.size()), static_cast<Eigen::Index>(cols.size()));
     Eigen::VectorXd b = Eigen::VectorXd::Ones(A.rows());
     for (Eigen::Index i = 0; i < A.rows(); ++i)
       for (std::size_t j = 0; j < cols.size(); ++j)
-        A(i, static_cast<Eigen::Index>(j)) = xs[static_cast<std::size_t>(i)][cols[j]] / std::max(ys[static_cast<std::size_t>(i)], 1e-12);
+        A(i, static_cast<Eigen::Index>(j)) = xs[static_cast<std::size_t>(i)][cols[j]] /
+                                             std::max(ys[static_cast<std::size_t>(i)], 1e-12);
     const Eigen::VectorXd p = A.colPivHouseholderQr().solve(b);
     c.setZero();
     bool negative = false;
     for (std::size_t j = 0; j < cols.size(); ++j) {
-      if (p(static_cast<Eigen::Index>(j)) < 0) used[cols[j]] = false, negative = true;
+      if (p(static_cast<Eigen::Index>(j)) < 0) used[static_cast<std::size_t>(cols[j])] = false, negative = true;
       else c[cols[j]] = p(static_cast<Eigen::Index>(j));
     }
     if (!negative) break;
@@ -142,13 +159,71 @@ Vec3 fit_terms(const std::vector<std::vector<ViewDraw>>& views) {
   return c;
 }
 
+// Sum over views of log(view's corner NEES per coordinate)^2: a view 2x over-confident
+// costs what a view 2x under-confident costs, and a few badly fitting views cannot pull
+// every other one off as a pooled mean would.
+double log_ratio_cost(const CornerNoiseModel& shape, const std::vector<std::vector<ViewDraw>>& views,
+                      const Vec4& c) {
+  double cost = 0;
+  for (const auto& draws : views) {
+    double sum = 0;
+    int n = 0;
+    for (const ViewDraw& d : draws) {
+      if (!d.detection) continue;
+      for (std::size_t k = 0; k < 4; ++k)
+        sum += d.corner_sq_errors_px2[k] / 2 / std::max(c.dot(terms_of(shape, d, k)), 1e-12);
+      n += 4;
+    }
+    if (n && sum > 0) cost += std::pow(std::log(sum / n), 2);
+  }
+  return cost;
+}
+
+// Coordinate search on each coefficient's logarithm, steps halving from a factor of 4;
+// a coefficient may shrink to `tiny` (its term off). Returns the cost reached.
+template <typename Vec, typename Cost>
+double log_search(Vec& c, const Cost& cost_of, double tiny) {
+  c = c.cwiseMax(tiny);
+  double best = cost_of(c);
+  for (double factor = 4; factor > 1.01; factor = std::sqrt(factor)) {
+    for (bool improved = true; improved;) {
+      improved = false;
+      for (Eigen::Index k = 0; k < c.size(); ++k)
+        for (double f : {factor, 1 / factor}) {
+          Vec trial = c;
+          trial[k] = std::max(trial[k] * f, tiny);
+          const double cost = cost_of(trial);
+          if (cost < best - 1e-12) best = cost, c = trial, improved = true;
+        }
+    }
+  }
+  return best;
+}
+
+// The four corner terms fitted in log ratio from the least-squares start.
+Vec4 fit_terms(const CornerNoiseModel& shape, const std::vector<std::vector<ViewDraw>>& views,
+               double* cost_out) {
+  Vec4 c = initial_terms(shape, views);
+  *cost_out = log_search(c, [&](const Vec4& t) { return log_ratio_cost(shape, views, t); }, 1e-8);
+  return c;
+}
+
 }  // namespace
 
 CornerNoiseModel fit_corner_noise(const CameraModel& camera, const std::vector<CalibrationView>& views,
                                   const std::vector<std::vector<ViewDraw>>& draws) {
-  const Vec3 c = fit_terms(draws);
   CornerNoiseModel m;
+  Vec4 c = Vec4::Zero();
+  double best = std::numeric_limits<double>::infinity();
+  for (double power : kNarrowPowers) {
+    CornerNoiseModel shape;
+    shape.narrow_power = power;
+    double cost = 0;
+    const Vec4 trial = fit_terms(shape, draws, &cost);
+    if (cost < best) best = cost, c = trial, m.narrow_power = power;
+  }
   m.floor_px = std::sqrt(c[0]), m.gain_px = std::sqrt(c[1]), m.aligned_px = std::sqrt(c[2]);
+  m.narrow_px = std::sqrt(c[3]);
   double sum = 0, sq = 0;
   int n = 0;
   for (const auto& view : draws)
@@ -169,7 +244,7 @@ CornerNoiseModel fit_corner_noise(const CameraModel& camera, const std::vector<C
     if (total == 0 || sum <= 0) break;
     // NEES scales as 1 / sigma^2.
     const double f = std::sqrt(sum / total / 6.0);
-    m.floor_px *= f, m.gain_px *= f, m.aligned_px *= f, m.radial_sigma_px *= f;
+    m.floor_px *= f, m.gain_px *= f, m.aligned_px *= f, m.radial_sigma_px *= f, m.narrow_px *= f;
   }
   return m;
 }

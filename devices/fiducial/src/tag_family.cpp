@@ -64,6 +64,10 @@ TagFamily::~TagFamily() { destroy_(family_); }
 int TagFamily::code_count() const { return static_cast<int>(family_->ncodes); }
 int TagFamily::cells_across_border() const { return family_->width_at_border; }
 int TagFamily::cells_across_total() const { return family_->total_width; }
+double TagFamily::quiet_cells(double paper_margin_cells) const {
+  if (family_->reversed_border) return 1;
+  return (family_->total_width - family_->width_at_border) / 2 + paper_margin_cells;
+}
 
 Result<cv::Mat> TagFamily::cells(int id) const {
   if (id < 0 || id >= code_count())

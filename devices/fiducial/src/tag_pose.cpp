@@ -92,9 +92,12 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
     radial(2 * i) = r.x, radial(2 * i + 1) = r.y;
     image[i] -= noise.radial_bias_px * r;
   }
-  const Eigen::Matrix<double, 8, 8> corner_cov =
-      sigma * sigma * Eigen::Matrix<double, 8, 8>::Identity() +
+  Eigen::Matrix<double, 8, 8> corner_cov =
       noise.radial_sigma_px * noise.radial_sigma_px * radial * radial.transpose();
+  for (int i = 0; i < 8; ++i) {
+    const double extra = noise.narrow_px[static_cast<std::size_t>(i / 2)];
+    corner_cov(i, i) += sigma * sigma + extra * extra;
+  }
 
   const auto object = tag_corners(size_m);
   std::vector<cv::Point3d> obj;

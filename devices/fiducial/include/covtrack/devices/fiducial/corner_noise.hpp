@@ -18,8 +18,12 @@
 // by radial_bias_px on average (corrected before the pose) with a spread of
 // radial_sigma_px common to the four corners. Independent corner noise would average it
 // away and make the depth over-confident, so it enters Sigma_c as a rank-one term.
+// Each corner also gets narrow_px^2 (4 px / band)^power, band the quiet band beyond its
+// narrower edge (quiet_band_px): where foreshortening squeezes the uniform margin beyond
+// the black border to a few pixels, AprilTag's edge refinement reaches past it and the
+// corner is biased (a constant of the view, up to 0.45 px on rendered tags).
 // The floor holds what else noise does not explain (blur, aliasing, the lens).
-// A calibration on rendered views with known truth measures the three coefficients
+// A calibration on rendered views with known truth measures the coefficients
 // (fit_corner_noise in noise_calibration.hpp, run by tests/devices/fiducial_nees_test).
 #include <array>
 
@@ -33,6 +37,13 @@ struct CornerNoiseModel {
   double aligned_px = 0.1;
   double radial_bias_px = 0;   // mean outward error of every corner (negative: inward)
   double radial_sigma_px = 0;  // spread of that common radial error
+  double narrow_px = 0;        // a corner's extra error where its quiet band is narrow
+  double narrow_power = 6;     // how fast that error grows as the band narrows
+
+  // The extra standard deviation (px) of a corner whose narrower edge has a quiet band
+  // of `quiet_band_px`: narrow_px * (kNarrowBandPx / band)^(power / 2).
+  double narrow_sigma_px(double quiet_band_px) const;
+  static constexpr double kNarrowBandPx = 4;
 
   // One corner coordinate's standard deviation (px), the same along u and v.
   double sigma_px(double image_noise, double contrast, double edge_length_px,
@@ -54,5 +65,15 @@ double tag_contrast(const cv::Mat& gray, const std::array<cv::Point2d, 4>& corne
 double edge_axis_alignment(const std::array<cv::Point2d, 4>& corners_px);
 
 double mean_edge_length_px(const std::array<cv::Point2d, 4>& corners_px);
+
+// Width (px) of the quiet band beyond each edge of the detected square: `quiet_cells`
+// cells (of cells_across_border per edge) measured outward from the edge's midpoint
+// through the quad's perspective, as the distance to the edge's line. Edge e runs from
+// corner e to corner e + 1.
+std::array<double, 4> quiet_band_px(const std::array<cv::Point2d, 4>& corners_px,
+                                    int cells_across_border, double quiet_cells);
+// Per corner, the narrower band of its two edges (corner k joins edges k - 1 and k).
+std::array<double, 4> corner_quiet_band_px(const std::array<cv::Point2d, 4>& corners_px,
+                                           int cells_across_border, double quiet_cells);
 
 }  // namespace covtrack::fiducial

@@ -29,6 +29,8 @@ struct ViewDraw {
   std::optional<Detection> detection;
   double image_noise = 0, contrast = 0, edge_length_px = 0, axis_alignment = 0;
   double corner_sq_error_px2 = 0;  // mean over the 8 coordinates, common radial part removed
+  std::array<double, 4> corner_sq_errors_px2{};  // per corner (u^2 + v^2), radial part removed
+  std::array<double, 4> corner_band_px{};        // per corner: quiet band (corner_quiet_band_px)
   double radial_error_px = 0;      // the four corners' mean outward error
 };
 
@@ -42,10 +44,11 @@ Result<std::vector<ViewDraw>> draw_view(const CameraModel& camera, const Detecto
 CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& draw);
 
 // Three stages. (0) The radial bias and spread: mean and standard deviation of the
-// per-draw common radial error. (1) Least squares of the per-view mean squared corner error against the
-// model's terms (relative residuals, so small and large errors count alike; a negative
-// coefficient is dropped). (2) The four corners' errors are not independent (neighbours
-// share an edge), so the pose NEES over the calibration views is brought to 6 by one
+// per-draw common radial error. (1) The four corner coefficients (floor, gain, aligned,
+// narrow) minimising the sum over views of log(view's corner NEES per coordinate)^2, so
+// that over- and under-confident views weigh alike; the narrow term's power is the best
+// of a few. (2) The four corners' errors are not independent (neighbours share an
+// edge), so the pooled pose NEES over the calibration views is brought to 6 by one
 // common factor on all coefficients.
 CornerNoiseModel fit_corner_noise(const CameraModel& camera,
                                   const std::vector<CalibrationView>& views,

@@ -28,6 +28,10 @@ class TagFamily {
   // across the whole printed tag (which may extend beyond that square).
   int cells_across_border() const;
   int cells_across_total() const;
+  // Cells of one uniform shade just beyond the detected square's edge: the family's white
+  // ring plus the paper around the print, or the one black ring of a reversed-border
+  // family (its data bits follow). The detector's edge refinement needs a few pixels of it.
+  double quiet_cells(double paper_margin_cells) const;
   // The printed tag `id` as total x total cells, 0 black and 255 white, row 0 at the top.
   Result<cv::Mat> cells(int id) const;
 

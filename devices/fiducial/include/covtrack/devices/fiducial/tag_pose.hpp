@@ -5,8 +5,8 @@
 // A square seen in perspective has two poses that fit (the tilt ambiguity); both come
 // from OpenCV's IPPE_SQUARE and are polished by Levenberg-Marquardt. The covariance is
 // (J^T Sigma_c^-1 J)^-1, J the Jacobian of the four projected corners w.r.t. xi, and
-// Sigma_c = sigma^2 I + radial_sigma^2 r r^T (r: the corners' unit radial directions
-// stacked; see corner_noise.hpp). Corners are first moved by -radial_bias along r. When the second pose fits nearly as well (its extra
+// Sigma_c = diag(sigma^2 + narrow_k^2) + radial_sigma^2 r r^T (r: the corners' unit
+// radial directions stacked; narrow_k: corner k's narrow-band term; see corner_noise.hpp). Corners are first moved by -radial_bias along r. When the second pose fits nearly as well (its extra
 // squared reprojection error below `ambiguity_chi2` corner variances) the covariance
 // gets the outer product of the step to it, so that it covers both.
 #include <array>
@@ -45,6 +45,7 @@ struct CornerNoise {
   double sigma_px = 0.1;       // independent, per coordinate
   double radial_bias_px = 0;   // common outward error, removed before the pose
   double radial_sigma_px = 0;  // common outward error's spread
+  std::array<double, 4> narrow_px{};  // per corner, extra independent error (narrow quiet band)
 };
 
 // sigma^2 (J^T J)^-1: the pose covariance from independent corner noise of sigma px.
