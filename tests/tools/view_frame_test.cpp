@@ -10,6 +10,7 @@
 
 #include "covtrack/client/convex_polygon.hpp"
 #include "covtrack/scene/scene_graph.hpp"
+#include "region_drawing.hpp"
 #include "regions_report.hpp"
 #include "view_labels.hpp"
 #include "view_widgets.hpp"
@@ -26,6 +27,9 @@ struct Frame {
   WidgetFrame widgets;
   ViewLabels labels;
 };
+
+// A legend of 9 lines (a scene with several streams) reaches up past the lowest drawers.
+int label_bottom(const cv::Size& screen) { return screen.height - legend_height_px(9, screen.height); }
 
 // Every frame of one loop at `fps`, as the view computes them (fixed scene values).
 std::vector<Frame> toolbox_loop(double fps) {
@@ -45,7 +49,8 @@ std::vector<Frame> toolbox_loop(double fps) {
     EXPECT_TRUE(report) << report.error().message;
     f.report = std::move(*report);
     f.widgets = widgets->update(f.report, screen);
-    f.labels = layout_labels(f.report, &f.widgets, screen);
+    // As the view lays them out: clear of its legend at the bottom (here a long one).
+    f.labels = layout_labels(f.report, &f.widgets, cv::Size(screen.width, label_bottom(screen)));
     frames.push_back(std::move(f));
   }
   return frames;
@@ -102,6 +107,9 @@ TEST(ViewFrame, LabelsGoFromInsideTheDrawersToLeaderLinesToTheListAndBack) {
     const auto& placed = f.labels.placed;
     for (std::size_t i = 0; i < placed.size(); ++i) {
       const client::ObjectRegions& r = f.report.objects[i].regions;
+      if (placed[i].placement != LabelPlacement::corner_list) {
+        EXPECT_LE(placed[i].box.max.y(), label_bottom({640, 480}) + 1e-9) << "under the legend at " << f.time_s;
+      }
       if (placed[i].placement == LabelPlacement::inside_inner) {
         for (const client::Vec2& corner : client::box_polygon(placed[i].box))
           EXPECT_TRUE(client::polygon_contains(r.inner, corner, 1e-6)) << f.time_s << " s, object " << i;

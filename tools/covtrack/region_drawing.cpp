@@ -98,7 +98,7 @@ void draw_pointer(cv::Mat& image, const WidgetFrame& w) {
 
 }  // namespace
 
-void draw_regions(cv::Mat& image, const RegionsReport& report, const WidgetFrame* widgets) {
+void draw_regions(cv::Mat& image, const RegionsReport& report, const WidgetFrame* widgets, int reserved_bottom_px) {
   const double scale = client::confidence_scale(report.confidence);
   const auto augmentation = [&](std::size_t i) {
     return widgets ? widgets->augmentations[i] : scene::Augmentation::outline;
@@ -123,7 +123,7 @@ void draw_regions(cv::Mat& image, const RegionsReport& report, const WidgetFrame
   }
   if (selecting) draw_pointer(image, *widgets);
 
-  const ViewLabels labels = layout_labels(report, widgets, image.size());
+  const ViewLabels labels = layout_labels(report, widgets, cv::Size(image.cols, image.rows - reserved_bottom_px));
   for (std::size_t i = 0; i < labels.placed.size(); ++i) {
     const client::PlacedLabel& p = labels.placed[i];
     if (p.leader)
@@ -139,17 +139,22 @@ void draw_regions(cv::Mat& image, const RegionsReport& report, const WidgetFrame
     }
 }
 
+constexpr int kLegendLine = 16, kLegendMargin = 6;
+
+int legend_height_px(std::size_t line_count, int rows) {
+  return std::min(rows, int(line_count) * kLegendLine + kLegendMargin);
+}
+
 void draw_legend(cv::Mat& image, const std::vector<std::string>& lines) {
   // Bottom-left: the label placer lists unanchored labels in the top-left corner.
-  constexpr int kLine = 16, kMargin = 6;
   int width = 0;
   for (const std::string& line : lines)
     width = std::max(width, cv::getTextSize(line, kLabelFont, 0.4, 1, nullptr).width);
-  const int height = std::min(image.rows, int(lines.size()) * kLine + kMargin);
-  const cv::Rect panel(0, image.rows - height, std::min(image.cols, width + 2 * kMargin), height);
+  const int height = legend_height_px(lines.size(), image.rows);
+  const cv::Rect panel(0, image.rows - height, std::min(image.cols, width + 2 * kLegendMargin), height);
   image(panel) = kPanel;
   for (std::size_t i = 0; i < lines.size(); ++i)
-    cv::putText(image, lines[i], cv::Point(kMargin, panel.y + kLine * int(i + 1) - 2), kLabelFont, 0.4, kLegend, 1,
+    cv::putText(image, lines[i], cv::Point(kLegendMargin, panel.y + kLegendLine * int(i + 1) - 2), kLabelFont, 0.4, kLegend, 1,
                 cv::LINE_AA);
 }
 

@@ -20,12 +20,16 @@
 
 namespace covtrack::cli {
 
-// `image` must be 8-bit BGR; drawn on in place.
-void draw_regions(cv::Mat& image, const RegionsReport& report, const WidgetFrame* widgets = nullptr);
+// `image` must be 8-bit BGR; drawn on in place. Labels keep out of the bottom
+// `reserved_bottom_px` rows (where the legend goes).
+void draw_regions(cv::Mat& image, const RegionsReport& report, const WidgetFrame* widgets = nullptr,
+                  int reserved_bottom_px = 0);
 
 // The selection likelihood's colour (BGR): yellow at 0 to red at 1.
 cv::Scalar likelihood_colour(double likelihood);
 void draw_legend(cv::Mat& image, const std::vector<std::string>& lines);
+// The rows draw_legend covers at the bottom of an image `rows` high.
+int legend_height_px(std::size_t line_count, int rows);
 
 Result<void> write_png(const cv::Mat& image, const std::string& path);
 

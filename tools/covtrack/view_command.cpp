@@ -188,9 +188,9 @@ int run_view(const ViewArgs& args) {
       std::cerr << "covtrack view: " << warning << "\n";
       warning.clear();
     }
-    draw_regions(image, *report, &widget_frame);
     auto lines = legend_lines(*model, latest_report, now);
     if (const std::string line = selection_line(*report, widget_frame); !line.empty()) lines.push_back(line);
+    draw_regions(image, *report, &widget_frame, legend_height_px(lines.size(), image.rows));
     draw_legend(image, lines);
 
     if (!args.png_path.empty()) {
