@@ -39,6 +39,9 @@ std::vector<int> convex_hull_indices(std::span<const Vec2> points);
 Polygon convex_hull(std::span<const Vec2> points);
 // The part of a convex polygon with normal . x <= offset.
 Polygon clip_half_plane(const Polygon& convex, const Vec2& normal, double offset);
+// The same into `out`, which has room for convex.size() + 1 points; returns the count.
+std::size_t clip_half_plane(std::span<const Vec2> convex, const Vec2& normal, double offset,
+                            Vec2* out);
 // Inside or within tolerance_px of a convex polygon.
 bool polygon_contains(const Polygon& convex, const Vec2& point, double tolerance_px = 1e-9);
 double polygon_area(const Polygon& polygon);
