@@ -64,11 +64,11 @@ RigidMap compose_exp(const Mat3& R0, const Vec3& t0, const Vec6& xi) {
     b = 0.5 - t2 / 24 * (1 - t2 / 30);
     c = 1.0 / 6 - t2 / 120 * (1 - t2 / 42);
   } else {
-    const double theta = std::sqrt(t2);
+    const double theta = std::sqrt(t2), inv = 1 / theta;
     const double sn = std::sin(theta), cs = std::cos(theta);
-    a = sn / theta;
-    b = (1 - cs) / t2;
-    c = (theta - sn) / (t2 * theta);
+    a = sn * inv;
+    b = (1 - cs) * inv * inv;
+    c = (theta - sn) * inv * inv * inv;
   }
   const double x = phi.x(), y = phi.y(), z = phi.z(), d = 1 - b * t2;
   const double E[9] = {d + b * x * x, b * x * y - a * z, b * x * z + a * y,

@@ -49,6 +49,9 @@ HalfPlane interior_tangent(const Vec2& ca, const Mat2& Sa, const Vec2& cb, const
       const double sa = std::sqrt(std::max(m.dot(Sa * m), 1e-300));
       const double sb = std::sqrt(std::max(m.dot(Sb * m), 1e-300));
       const double g = m.dot(d) - sa + sb;
+      // g is in pixels (per unit |m|): the two supports differ by less than 1e-7 px, so the
+      // line is tangent to both to that; the min below makes it conservative anyway.
+      if (std::abs(g) <= 1e-7 * std::sqrt(m.squaredNorm())) break;
       (g > 0 ? lo : hi) = t;
       const double dg = n1.dot(d) - n1.dot(Sa * m) / sa + n1.dot(Sb * m) / sb;
       double next = t - g / dg;
