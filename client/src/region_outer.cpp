@@ -13,6 +13,7 @@ struct SupportLine {
   Vec2 normal;  // unit
   double offset;
   Vec2 contact;
+  Eigen::Index ellipse;  // the one touching
 };
 
 // The confidence ellipses, one column per quantity (centre u, v; shape = scale^2 times
@@ -36,11 +37,15 @@ class Ellipses {
                 (x * x * e_.col(2) + 2 * x * y * e_.col(3) + y * y * e_.col(4)).max(0.0).sqrt();
     Eigen::Index best;
     const double offset = e_.col(5).maxCoeff(&best);
-    // Reached at c + S n / sqrt(n^T S n) on the best ellipse.
-    const Vec2 c(e_(best, 0), e_(best, 1));
-    const Vec2 Sn(e_(best, 2) * x + e_(best, 3) * y, e_(best, 3) * x + e_(best, 4) * y);
+    return {n, offset, farthest_point(best, n), best};
+  }
+
+  // The point of ellipse i farthest along n (any length): c + S n / sqrt(n^T S n).
+  Vec2 farthest_point(Eigen::Index i, const Vec2& n) const {
+    const Vec2 c(e_(i, 0), e_(i, 1));
+    const Vec2 Sn(e_(i, 2) * n.x() + e_(i, 3) * n.y(), e_(i, 3) * n.x() + e_(i, 4) * n.y());
     const double r = std::sqrt(std::max(n.dot(Sn), 0.0));
-    return {n, offset, r > 0 ? Vec2(c + Sn / r) : c};
+    return r > 0 ? Vec2(c + Sn / r) : c;
   }
 
  private:
@@ -86,9 +91,9 @@ Polygon expand_region(std::span<const ProjectedVertex> vertices, const RegionOpt
   const double tolerance2 = o.max_polygon_error_px * o.max_polygon_error_px;
 
   // Start with 8 directions; split a gap while the corner of its two lines lies farther
-  // than the tolerance from the segment between their contact points (a chord of the
-  // convex set, so inside it). Depth-first with an explicit stack: corners come out in
-  // counter-clockwise order, the last line being the first one again.
+  // than the tolerance from the points of the set it is compared with (below). Depth-first
+  // with an explicit stack: corners come out in counter-clockwise order, the last line
+  // being the first one again.
   constexpr double kSmallestGap = 1e-7;  // sin of the gap; below it a corner is as tight as doubles get
   constexpr double h = std::numbers::sqrt2 / 2;
   static const Vec2 kInitial[] = {{1, 0}, {h, h}, {0, 1}, {-h, h}, {-1, 0}, {-h, -h}, {0, -1}, {h, -h}};
@@ -103,7 +108,17 @@ Polygon expand_region(std::span<const ProjectedVertex> vertices, const RegionOpt
   while (!pending.empty()) {
     const SupportLine& next = pending.back();
     const Vec2 q = corner(current, next);
-    const bool loose = squared_distance_to_segment(q, current.contact, next.contact) > tolerance2;
+    // The corner's distance to the hull is at most its distance to any point of the hull:
+    // the chord between the contacts, and, when one ellipse touches both lines, that
+    // ellipse's point facing the corner (the bisector's contact). On a circle of radius R
+    // and a gap g the chord gives R (1/cos(g/2) - cos(g/2)), the arc R (1/cos(g/2) - 1),
+    // about half: fewer splits along the ellipses for the same guarantee.
+    double gap2 = squared_distance_to_segment(q, current.contact, next.contact);
+    if (gap2 > tolerance2 && current.ellipse == next.ellipse)
+      gap2 = std::min(gap2, (q - ellipses.farthest_point(current.ellipse,
+                                                         current.normal + next.normal))
+                                .squaredNorm());
+    const bool loose = gap2 > tolerance2;
     if (loose && cross(current.normal, next.normal) > kSmallestGap &&
         static_cast<int>(outer.size() + pending.size()) < o.max_outer_corners) {
       pending.push_back(ellipses.support(split_direction(current, next)));
