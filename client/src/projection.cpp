@@ -50,12 +50,26 @@ struct SigmaPoses {
   double wm0, wc0, wi;
 };
 
-// T * Exp(xi), as pose * se3_exp(xi) but with one sin/cos pair for both the rotation and
-// the left Jacobian (se3_exp evaluates them separately; this is the per-object hot path).
-// With K = skew(phi), theta = |phi| and K^2 = phi phi^T - theta^2 I:
-//   R = (1 - b theta^2) I + a K + b phi phi^T,   V rho = (1 - c theta^2) rho + b phi x rho + c phi (phi . rho),
+RigidMap compose(const Mat3& R0, const Vec3& t0, const double (&E)[9], const Vec3& te) {
+  RigidMap m;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j)
+      m.r[3 * i + j] = R0(i, 0) * E[j] + R0(i, 1) * E[3 + j] + R0(i, 2) * E[6 + j];
+    m.t[i] = R0(i, 0) * te.x() + R0(i, 1) * te.y() + R0(i, 2) * te.z() + t0[i];
+  }
+  return m;
+}
+
+// T * Exp(xi) and T * Exp(-xi), as pose * se3_exp(+-xi) but with one sin/cos pair for both
+// signs and for both the rotation and the left Jacobian (se3_exp evaluates them
+// separately; this is the per-object hot path). With K = skew(phi), theta = |phi| and
+// K^2 = phi phi^T - theta^2 I:
+//   R = (1 - b theta^2) I + b phi phi^T + a K,
+//   V rho = (1 - c theta^2) rho + c phi (phi . rho) + b phi x rho,
 //   a = sin(theta)/theta, b = (1 - cos(theta))/theta^2, c = (theta - sin(theta))/theta^3.
-RigidMap compose_exp(const Mat3& R0, const Vec3& t0, const Vec6& xi) {
+// Negating xi flips the a K term of R and the terms of V rho that are odd in xi.
+void compose_exp_pair(const Mat3& R0, const Vec3& t0, const Vec6& xi, RigidMap& plus,
+                      RigidMap& minus) {
   const Vec3 rho = xi.head<3>(), phi = xi.tail<3>();
   const double t2 = phi.squaredNorm();
   double a, b, c;
@@ -71,17 +85,18 @@ RigidMap compose_exp(const Mat3& R0, const Vec3& t0, const Vec6& xi) {
     c = (theta - sn) * inv * inv * inv;
   }
   const double x = phi.x(), y = phi.y(), z = phi.z(), d = 1 - b * t2;
-  const double E[9] = {d + b * x * x, b * x * y - a * z, b * x * z + a * y,
-                       b * x * y + a * z, d + b * y * y, b * y * z - a * x,
-                       b * x * z - a * y, b * y * z + a * x, d + b * z * z};
-  const Vec3 te = (1 - c * t2) * rho + b * phi.cross(rho) + c * phi.dot(rho) * phi;
-  RigidMap m;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j)
-      m.r[3 * i + j] = R0(i, 0) * E[j] + R0(i, 1) * E[3 + j] + R0(i, 2) * E[6 + j];
-    m.t[i] = R0(i, 0) * te.x() + R0(i, 1) * te.y() + R0(i, 2) * te.z() + t0[i];
-  }
-  return m;
+  const double ax = a * x, ay = a * y, az = a * z;
+  const double bxy = b * x * y, bxz = b * x * z, byz = b * y * z;
+  const double Ep[9] = {d + b * x * x, bxy - az, bxz + ay,
+                        bxy + az, d + b * y * y, byz - ax,
+                        bxz - ay, byz + ax, d + b * z * z};
+  const double Em[9] = {Ep[0], bxy + az, bxz - ay,
+                        bxy - az, Ep[4], byz + ax,
+                        bxz + ay, byz - ax, Ep[8]};
+  const Vec3 odd = (1 - c * t2) * rho + c * phi.dot(rho) * phi;
+  const Vec3 even = b * phi.cross(rho);
+  plus = compose(R0, t0, Ep, even + odd);
+  minus = compose(R0, t0, Em, even - odd);
 }
 
 SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut) {
@@ -100,11 +115,9 @@ SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut
   const Mat3 R = pose.T.linear();
   const Vec3 t = pose.T.translation();
   SigmaPoses s;
-  s.T[0] = compose_exp(R, t, Vec6::Zero());
-  for (int i = 0; i < kN; ++i) {
-    s.T[1 + i] = compose_exp(R, t, S.col(i));
-    s.T[1 + kN + i] = compose_exp(R, t, -S.col(i));
-  }
+  const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  s.T[0] = compose(R, t, I, Vec3::Zero());
+  for (int i = 0; i < kN; ++i) compose_exp_pair(R, t, S.col(i), s.T[1 + i], s.T[1 + kN + i]);
   s.wm0 = lambda / (kN + lambda);
   s.wc0 = s.wm0 + (1 - ut.alpha * ut.alpha + ut.beta);
   s.wi = 0.5 / (kN + lambda);
