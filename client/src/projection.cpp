@@ -32,11 +32,72 @@ namespace {
 constexpr int kN = 6;
 constexpr int kSigmaPoints = 2 * kN + 1;
 
+// A sigma pose as rotation and translation: applying it to a vertex is 9 multiply-adds,
+// written out (Eigen's fixed 3x3 products are not inlined at -O2 in this loop).
+struct RigidMap {
+  double r[9];  // row-major
+  double t[3];
+  Vec3 operator()(const Vec3& p) const {
+    return {r[0] * p.x() + r[1] * p.y() + r[2] * p.z() + t[0],
+            r[3] * p.x() + r[4] * p.y() + r[5] * p.z() + t[1],
+            r[6] * p.x() + r[7] * p.y() + r[8] * p.z() + t[2]};
+  }
+};
+
 // The 2n+1 perturbed poses T * Exp(sigma_i) and their weights, shared by all vertices.
 struct SigmaPoses {
-  std::array<Pose, kSigmaPoints> T;
+  std::array<RigidMap, kSigmaPoints> T;
   double wm0, wc0, wi;
 };
+
+RigidMap compose(const Mat3& R0, const Vec3& t0, const double (&E)[9], const Vec3& te) {
+  RigidMap m;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j)
+      m.r[3 * i + j] = R0(i, 0) * E[j] + R0(i, 1) * E[3 + j] + R0(i, 2) * E[6 + j];
+    m.t[i] = R0(i, 0) * te.x() + R0(i, 1) * te.y() + R0(i, 2) * te.z() + t0[i];
+  }
+  return m;
+}
+
+// T * Exp(xi) and T * Exp(-xi), as pose * se3_exp(+-xi) but with one sin/cos pair for both
+// signs and for both the rotation and the left Jacobian (se3_exp evaluates them
+// separately; this is the per-object hot path). With K = skew(phi), theta = |phi| and
+// K^2 = phi phi^T - theta^2 I:
+//   R = (1 - b theta^2) I + b phi phi^T + a K,
+//   V rho = (1 - c theta^2) rho + c phi (phi . rho) + b phi x rho,
+//   a = sin(theta)/theta, b = (1 - cos(theta))/theta^2, c = (theta - sin(theta))/theta^3.
+// Negating xi flips the a K term of R and the terms of V rho that are odd in xi.
+void compose_exp_pair(const Mat3& R0, const Vec3& t0, const Vec6& xi, RigidMap& plus,
+                      RigidMap& minus) {
+  const Vec3 rho = xi.head<3>(), phi = xi.tail<3>();
+  const double t2 = phi.squaredNorm();
+  double a, b, c;
+  if (t2 < 1e-4) {  // theta < 1e-2: series, error below theta^6/5040 (c would cancel)
+    a = 1 - t2 / 6 * (1 - t2 / 20);
+    b = 0.5 - t2 / 24 * (1 - t2 / 30);
+    c = 1.0 / 6 - t2 / 120 * (1 - t2 / 42);
+  } else {
+    const double theta = std::sqrt(t2), inv = 1 / theta;
+    const double sn = std::sin(theta), cs = std::cos(theta);
+    a = sn * inv;
+    b = (1 - cs) * inv * inv;
+    c = (theta - sn) * inv * inv * inv;
+  }
+  const double x = phi.x(), y = phi.y(), z = phi.z(), d = 1 - b * t2;
+  const double ax = a * x, ay = a * y, az = a * z;
+  const double bxy = b * x * y, bxz = b * x * z, byz = b * y * z;
+  const double Ep[9] = {d + b * x * x, bxy - az, bxz + ay,
+                        bxy + az, d + b * y * y, byz - ax,
+                        bxz - ay, byz + ax, d + b * z * z};
+  const double Em[9] = {Ep[0], bxy + az, bxz - ay,
+                        bxy - az, Ep[4], byz + ax,
+                        bxz + ay, byz - ax, Ep[8]};
+  const Vec3 odd = (1 - c * t2) * rho + c * phi.dot(rho) * phi;
+  const Vec3 even = b * phi.cross(rho);
+  plus = compose(R0, t0, Ep, even + odd);
+  minus = compose(R0, t0, Em, even - odd);
+}
 
 SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut) {
   const double lambda = ut.alpha * ut.alpha * (kN + ut.kappa) - kN;
@@ -51,12 +112,12 @@ SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut
     Eigen::SelfAdjointEigenSolver<Mat6> eig(scaled);
     S = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
   }
+  const Mat3 R = pose.T.linear();
+  const Vec3 t = pose.T.translation();
   SigmaPoses s;
-  s.T[0] = pose.T;
-  for (int i = 0; i < kN; ++i) {
-    s.T[1 + i] = pose.T * se3_exp(S.col(i));
-    s.T[1 + kN + i] = pose.T * se3_exp(-S.col(i));
-  }
+  const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  s.T[0] = compose(R, t, I, Vec3::Zero());
+  for (int i = 0; i < kN; ++i) compose_exp_pair(R, t, S.col(i), s.T[1 + i], s.T[1 + kN + i]);
   s.wm0 = lambda / (kN + lambda);
   s.wc0 = s.wm0 + (1 - ut.alpha * ut.alpha + ut.beta);
   s.wi = 0.5 / (kN + lambda);
@@ -65,6 +126,9 @@ SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut
 
 bool rotation_too_uncertain(const Mat6& C, double max_sigma_rad) {
   const Eigen::Matrix3d Crot = C.bottomRightCorner<3, 3>();
+  // The largest eigenvalue of a PSD matrix is at most its trace: the usual case needs no
+  // eigenvalues (the closed form costs an acos and a cos per object).
+  if (Crot.trace() <= max_sigma_rad * max_sigma_rad) return false;
   // Largest eigenvalue of a 3x3 symmetric matrix, closed form (cheap, per object).
   const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>()
                              .computeDirect(Crot, Eigen::EigenvaluesOnly)
@@ -83,15 +147,16 @@ Mat2 repair_psd(const Mat2& C, bool& repaired) {
          eig.eigenvectors().transpose();
 }
 
-ProjectedVertex project_unscented(const Camera& camera, const SigmaPoses& s,
-                                  const Vec3& p, const ProjectionOptions& o,
-                                  ProjectedVertex v) {
+// `v` holds the unperturbed vertex's pixel (sigma point 0: the pose itself).
+void project_unscented(const Camera& camera, const SigmaPoses& s, const Vec3& p,
+                       const ProjectionOptions& o, ProjectedVertex& v) {
   std::array<Vec2, kSigmaPoints> px;
-  for (int i = 0; i < kSigmaPoints; ++i) {
-    const Vec3 pc = s.T[i] * p;
+  px[0] = v.mean_px;
+  for (int i = 1; i < kSigmaPoints; ++i) {
+    const Vec3 pc = s.T[i](p);
     if (pc.z() < o.near_m) {
       v.flags.sigma_point_behind_camera = true;
-      return v;  // a pixel from behind the camera would poison the sums
+      return;  // a pixel from behind the camera would poison the sums
     }
     px[i] = camera.project(pc);
   }
@@ -105,38 +170,14 @@ ProjectedVertex project_unscented(const Camera& camera, const SigmaPoses& s,
   }
   v.mean_px = mean;
   v.covariance_px2 = repair_psd(cov, v.flags.covariance_repaired);
-  return v;
-}
-
-// Everything but the pose-uncertainty part, shared by both methods.
-ProjectedVertex start_vertex(const Camera& camera, const UncertainPose& pose, const Vec3& p,
-                             const ProjectionOptions& o, bool rotation_flag) {
-  ProjectedVertex v;
-  const Vec3 pc = pose.T * p;
-  v.depth_m = pc.z();
-  v.flags.unbounded = pose.unbounded;
-  v.flags.rotation_too_uncertain = rotation_flag;
-  if (pc.z() < o.near_m) {
-    v.flags.behind_camera = true;
-    return v;
-  }
-  v.mean_px = camera.project(pc);
-  return v;
-}
-
-void finish_vertex(const Camera& camera, const Vec3& pc, const ProjectionOptions& o,
-                   ProjectedVertex& v) {
-  if (o.add_intrinsic_uncertainty && v.flags.usable())
-    v.covariance_px2 += camera.intrinsic_covariance(pc);
 }
 
 }  // namespace
 
-std::vector<ProjectedVertex> project_vertices(const Camera& camera, const UncertainPose& pose,
-                                              std::span<const Vec3> points,
-                                              const ProjectionOptions& o) {
-  std::vector<ProjectedVertex> out;
-  out.reserve(points.size());
+void project_vertices(const Camera& camera, const UncertainPose& pose,
+                      std::span<const Vec3> points, const ProjectionOptions& o,
+                      std::vector<ProjectedVertex>& out) {
+  out.clear();
   // An unbounded pose has no covariance to transform (it may hold infinities).
   const bool use_covariance = !pose.unbounded;
   const bool rot_flag =
@@ -146,18 +187,33 @@ std::vector<ProjectedVertex> project_vertices(const Camera& camera, const Uncert
   if (unscented) sigma = make_sigma_poses(pose, o.unscented);
 
   for (const Vec3& p : points) {
-    ProjectedVertex v = start_vertex(camera, pose, p, o, rot_flag);
-    if (!v.flags.behind_camera && use_covariance) {
-      if (unscented) {
-        v = project_unscented(camera, sigma, p, o, v);
-      } else {
-        const Mat26 J = pixel_jacobian_wrt_perturbation(camera, pose.T, p);
-        v.covariance_px2 = J * pose.covariance * J.transpose();
-      }
+    ProjectedVertex& v = out.emplace_back();
+    const Vec3 pc = pose.T * p;
+    v.depth_m = pc.z();
+    v.flags.unbounded = pose.unbounded;
+    v.flags.rotation_too_uncertain = rot_flag;
+    if (pc.z() < o.near_m) {
+      v.flags.behind_camera = true;
+      continue;
     }
-    finish_vertex(camera, pose.T * p, o, v);
-    out.push_back(v);
+    v.mean_px = camera.project(pc);
+    if (unscented) {
+      project_unscented(camera, sigma, p, o, v);
+    } else if (use_covariance) {
+      const Mat26 J = pixel_jacobian_wrt_perturbation(camera, pose.T, p);
+      v.covariance_px2 = J * pose.covariance * J.transpose();
+    }
+    if (o.add_intrinsic_uncertainty && v.flags.usable())
+      v.covariance_px2 += camera.intrinsic_covariance(pc);
   }
+}
+
+std::vector<ProjectedVertex> project_vertices(const Camera& camera, const UncertainPose& pose,
+                                              std::span<const Vec3> points,
+                                              const ProjectionOptions& o) {
+  std::vector<ProjectedVertex> out;
+  out.reserve(points.size());
+  project_vertices(camera, pose, points, o, out);
   return out;
 }
 

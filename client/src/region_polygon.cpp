@@ -89,17 +89,23 @@ Polygon convex_hull(std::span<const Vec2> points) {
   return h;
 }
 
-Polygon clip_half_plane(const Polygon& poly, const Vec2& normal, double offset) {
-  Polygon out;
+std::size_t clip_half_plane(std::span<const Vec2> poly, const Vec2& normal, double offset,
+                            Vec2* out) {
+  std::size_t m = 0;
   const std::size_t n = poly.size();
-  out.reserve(n + 1);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2& a = poly[i];
-    const Vec2& b = poly[(i + 1) % n];
+    const Vec2& b = poly[i + 1 == n ? 0 : i + 1];
     const double da = normal.dot(a) - offset, db = normal.dot(b) - offset;
-    if (da <= 0) out.push_back(a);
-    if ((da < 0 && db > 0) || (da > 0 && db < 0)) out.push_back(a + (da / (da - db)) * (b - a));
+    if (da <= 0) out[m++] = a;
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) out[m++] = a + (da / (da - db)) * (b - a);
   }
+  return m;
+}
+
+Polygon clip_half_plane(const Polygon& poly, const Vec2& normal, double offset) {
+  Polygon out(poly.size() + 1);
+  out.resize(clip_half_plane(poly, normal, offset, out.data()));
   return out;
 }
 

@@ -30,19 +30,28 @@ HalfPlane interior_tangent(const Vec2& ca, const Mat2& Sa, const Vec2& cb, const
   const Vec2 n0 = Vec2(e.y(), -e.x()).normalized();  // outward for counter-clockwise hulls
   const Vec2 n1(-n0.y(), n0.x());
   const Vec2 d = ca - cb;
-  const auto f = [&](const Vec2& m) {
-    return m.dot(d) - std::sqrt(std::max(m.dot(Sa * m), 0.0)) +
-           std::sqrt(std::max(m.dot(Sb * m), 0.0));
-  };
+  // f(-n1) > 0 and f(n1) < 0, with n1 . d = -|e| and the supports even in n:
+  // |sb(n1) - sa(n1)| < |e|.
+  const double edge = e.norm();
+  const double sa1 = std::sqrt(std::max(n1.dot(Sa * n1), 0.0));
+  const double sb1 = std::sqrt(std::max(n1.dot(Sb * n1), 0.0));
   double t = 0;
-  if (f(-n1) > 0 && f(n1) < 0) {
+  if (std::abs(sb1 - sa1) < edge) {
     // Root bracket in t, widened to infinity on the open side.
     double lo = -std::numeric_limits<double>::infinity(), hi = -lo;
+    // Start where f's linear part meets the supports along n0: with n1 . d = -|e|,
+    // f(t) ~ -t |e| - sa(n0) + sb(n0): close to the root when the ellipses are small
+    // against the edge, so Newton needs two or three steps instead of six.
+    t = (std::sqrt(std::max(n0.dot(Sb * n0), 0.0)) - std::sqrt(std::max(n0.dot(Sa * n0), 0.0))) /
+        edge;
     for (int it = 0; it < 60; ++it) {
       const Vec2 m = n0 + t * n1;
       const double sa = std::sqrt(std::max(m.dot(Sa * m), 1e-300));
       const double sb = std::sqrt(std::max(m.dot(Sb * m), 1e-300));
       const double g = m.dot(d) - sa + sb;
+      // g is in pixels (per unit |m|): the two supports differ by less than 1e-7 px, so the
+      // line is tangent to both to that; the min below makes it conservative anyway.
+      if (std::abs(g) <= 1e-7 * std::sqrt(m.squaredNorm())) break;
       (g > 0 ? lo : hi) = t;
       const double dg = n1.dot(d) - n1.dot(Sa * m) / sa + n1.dot(Sb * m) / sb;
       double next = t - g / dg;
@@ -51,7 +60,9 @@ HalfPlane interior_tangent(const Vec2& ca, const Mat2& Sa, const Vec2& cb, const
                : std::isfinite(lo)                    ? std::max(2 * lo, lo + 1)
                                                       : std::min(2 * hi, hi - 1);
       }
-      const bool done = std::abs(next - t) <= 1e-12 * (1 + std::abs(t));
+      // 1e-10 in t is 1e-10 rad at the root's angle: far below a pixel at any distance,
+      // and the min below keeps the line conservative whatever is left.
+      const bool done = std::abs(next - t) <= 1e-10 * (1 + std::abs(t));
       t = next;
       if (done) break;
     }
@@ -68,22 +79,32 @@ Polygon contract_region(std::span<const ProjectedVertex> hull, const RegionOptio
   if (k < 3) return {};  // a point or a segment has no interior to keep
   const double s2 = std::pow(confidence_scale(o.confidence), 2);
 
-  // Start from a box well around the hull; the half-planes cut it down.
+  // Start from a box well around the hull; the half-planes cut it down. Each cut adds at
+  // most one corner, so two buffers of 4 + k corners hold every step (no allocation per cut).
   Eigen::AlignedBox2d box;
   for (const ProjectedVertex& v : hull) box.extend(v.mean_px);
   const double margin = box.diagonal().norm() + 1.0;
-  Polygon region = {box.min() - Vec2(margin, margin), Vec2(box.max().x() + margin, box.min().y() - margin),
-                    box.max() + Vec2(margin, margin), Vec2(box.min().x() - margin, box.max().y() + margin)};
-  for (std::size_t i = 0; i < k && !region.empty(); ++i) {
+  std::vector<Vec2> buffers(2 * (4 + k));
+  Vec2* region = buffers.data();
+  Vec2* next = region + 4 + k;
+  region[0] = box.min() - Vec2(margin, margin);
+  region[1] = Vec2(box.max().x() + margin, box.min().y() - margin);
+  region[2] = box.max() + Vec2(margin, margin);
+  region[3] = Vec2(box.min().x() - margin, box.max().y() + margin);
+  std::size_t size = 4;
+  for (std::size_t i = 0; i < k && size > 0; ++i) {
     const ProjectedVertex& a = hull[i];
     const ProjectedVertex& b = hull[(i + 1) % k];
     const HalfPlane h =
         interior_tangent(a.mean_px, s2 * a.covariance_px2, b.mean_px, s2 * b.covariance_px2);
-    region = clip_half_plane(region, h.normal, h.offset);
+    size = clip_half_plane(std::span<const Vec2>(region, size), h.normal, h.offset, next);
+    std::swap(region, next);
   }
   // A sliver left by rounding is no region.
-  if (region.size() < 3 || polygon_area(region) <= 1e-9) return {};
-  return region;
+  if (size < 3) return {};
+  Polygon out(region, region + size);
+  if (polygon_area(out) <= 1e-9) return {};
+  return out;
 }
 
 }  // namespace covtrack::client

@@ -1,7 +1,10 @@
 // One frame = 1,000 objects x 8 hull vertices: projection + outer + inner + assessment.
 // Unscented (default) vs the linear fast path vs a 1,000-sample Monte Carlo of the same
 // frame. Single thread. Run: build/tests/client/bench_regions
+#include <cstdio>
+#include <map>
 #include <random>
+#include <string>
 
 #include <benchmark/benchmark.h>
 
@@ -106,11 +109,17 @@ const std::vector<std::vector<ProjectedVertex>>& projected_frame() {
 
 void BM_FrameOuterOnly(benchmark::State& state) {
   const RegionOptions ro;
-  for (auto _ : state)
+  std::size_t corners = 0;
+  for (auto _ : state) {
+    corners = 0;
     for (const auto& vertices : projected_frame()) {
       Polygon outer = expand_region(vertices, ro);
+      corners += outer.size();
       benchmark::DoNotOptimize(outer.data());
     }
+  }
+  // Each corner costs one support evaluation over all the object's ellipses.
+  state.counters["corners_per_object"] = double(corners) / projected_frame().size();
 }
 
 void BM_FrameInnerOnly(benchmark::State& state) {
@@ -137,4 +146,36 @@ BENCHMARK(BM_FrameProjectionOnlyUnscented)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameOuterOnly)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameInnerOnly)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameMonteCarlo1000)->Unit(benchmark::kMillisecond);
-BENCHMARK_MAIN();
+// The figures are ratios within one run (the machine's speed cancels): after the
+// usual table, the CPU time of each frame against the unscented frame.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  RatioReporter() : ConsoleReporter(OO_None) {}  // plain text, as when piped
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& r : runs)  // the plain runs, or the mean when repeated
+      if (r.run_type == Run::RT_Iteration || r.aggregate_name == "mean")
+        cpu_ms_[r.run_name.function_name] = r.GetAdjustedCPUTime();
+  }
+  void print_ratios() const {
+    const auto unscented = cpu_ms_.find("BM_FrameUnscented");
+    if (unscented == cpu_ms_.end()) return;
+    std::printf("\nCPU time per frame as a ratio to BM_FrameUnscented (%.3f ms), same run:\n",
+                unscented->second);
+    for (const auto& [name, ms] : cpu_ms_)
+      std::printf("  %-34s %8.3f\n", name.c_str(), ms / unscented->second);
+  }
+
+ private:
+  std::map<std::string, double> cpu_ms_;
+};
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  reporter.print_ratios();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -146,6 +146,36 @@ TEST(Projection, UnscentedEqualsLinearWhenTheMapIsLinear) {
   EXPECT_LT((u.mean_px - l.mean_px).norm(), 1e-3);
 }
 
+// The plain UT written out with the protocol's se3_exp: the library's sigma poses use their
+// own exp (one sin/cos pair, a series below 0.01 rad), which must be the same map.
+Mat2 reference_unscented(const Camera& cam, const UncertainPose& pose, const Vec3& p) {
+  const Mat6 S = Eigen::LLT<Mat6>(3.0 * pose.covariance).matrixL();  // n + kappa = 3
+  std::vector<Vec2> px = {cam.project(pose.T * p)};
+  for (int i = 0; i < 6; ++i)
+    for (double sign : {1.0, -1.0}) px.push_back(cam.project(pose.T * se3_exp(sign * S.col(i)) * p));
+  const double w0 = -1.0, wi = 1.0 / 6;  // kappa / (n + kappa), 1 / (2 (n + kappa))
+  Vec2 mean = w0 * px[0];
+  for (std::size_t i = 1; i < px.size(); ++i) mean += wi * px[i];
+  Mat2 cov = w0 * (px[0] - mean) * (px[0] - mean).transpose();
+  for (std::size_t i = 1; i < px.size(); ++i) cov += wi * (px[i] - mean) * (px[i] - mean).transpose();
+  return cov;
+}
+
+TEST(Projection, UnscentedSigmaPosesAreTheSe3Exp) {
+  const Camera cam = test::example_camera();
+  ProjectionOptions o;
+  o.add_intrinsic_uncertainty = false;
+  // 0.001 and 0.3 deg: sigma points under 0.01 rad (series); 3 and 12 deg: closed form.
+  for (double rot_deg : {0.001, 0.3, 3.0, 12.0}) {
+    const UncertainPose pose{object_pose(), covariance(0.01, rot_deg * kDeg), false};
+    for (const Vec3& p : {Vec3(0.25, -0.15, 0.2), Vec3(-0.3, 0.1, -0.1)}) {
+      const Mat2 ref = reference_unscented(cam, pose, p);
+      const ProjectedVertex v = project_vertex(cam, pose, p, o);
+      EXPECT_LT(relative_frobenius(v.covariance_px2, ref), 1e-9) << rot_deg << " deg";
+    }
+  }
+}
+
 TEST(Projection, ScaledUnscentedOptionIsUsed) {
   const Camera cam = test::example_camera();
   const UncertainPose pose{object_pose(), covariance(0.01, 10 * kDeg), false};

@@ -155,6 +155,32 @@ TEST(OuterRegion, ContainsEveryEllipseAndStaysWithinTheBound) {
   std::printf("outer region: %.1f corners on average\n", double(corners) / 200);
 }
 
+// Zero covariance everywhere (sqrt(0) supports): the outer region is the hull of the
+// centres, up to the tolerance (a corner may stand off an edge by at most
+// max_polygon_error_px); one point or collinear points give themselves.
+TEST(OuterRegion, ZeroCovarianceGivesTheHullOfTheCentres) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0, 400);
+  const RegionOptions o;
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<ProjectedVertex> vertices(3 + trial % 8);
+    std::vector<Vec2> centres;
+    for (ProjectedVertex& v : vertices) centres.push_back(v.mean_px = Vec2(u(rng), u(rng)));
+    const Polygon outer = expand_region(vertices, o);
+    ASSERT_TRUE(outer.size() >= 3 && outer.front().allFinite()) << "trial " << trial;
+    const Polygon hull = convex_hull(centres);
+    for (const Vec2& c : centres) EXPECT_TRUE(polygon_contains(outer, c, 1e-9)) << trial;
+    for (const Vec2& q : outer)
+      EXPECT_LE(distance_to_polygon_boundary(hull, q), o.max_polygon_error_px + 1e-9) << trial;
+  }
+  std::vector<ProjectedVertex> collinear(3);
+  for (int i = 0; i < 3; ++i) collinear[i].mean_px = Vec2(10 + 5 * i, 20 + 5 * i);
+  for (const Vec2& q : expand_region(collinear, o))
+    EXPECT_LT(std::abs((q - Vec2(10, 20)).x() - (q - Vec2(10, 20)).y()), 1e-9) << "on the line";
+  const Polygon point = expand_region(std::span(collinear).first(1), o);
+  for (const Vec2& q : point) EXPECT_LT((q - Vec2(10, 20)).norm(), 1e-9);
+}
+
 TEST(Regions, WithoutErrorAllRegionsAreTheMeanHull) {
   const Camera cam = test::example_camera();
   const auto verts = box_vertices(0.2, 0.15, 0.1);
@@ -183,6 +209,35 @@ TEST(Regions, NestingInnerInHullInOuter) {
   for (const Vec2& p : hull) EXPECT_TRUE(polygon_contains(r.outer, p, 1e-9));
   EXPECT_LT(polygon_area(r.inner), polygon_area(hull));
   EXPECT_GT(polygon_area(r.outer), polygon_area(hull));
+}
+
+// Each edge of the inner region lies on a line tangent to the confidence ellipses of two
+// adjacent hull vertices, both on its outer side (seed 5.5.2), not merely near one.
+TEST(Regions, InnerEdgesAreInteriorTangents) {
+  const Camera cam = test::example_camera();
+  const double scale = confidence_scale(0.95);
+  for (double rotation_deg : {0.5, 1.0, 2.0}) {
+    const ObjectRegions r = compute_object_regions(cam, box_pose(0.003, rotation_deg * kDeg),
+                                                   box_vertices(0.2, 0.15, 0.1));
+    ASSERT_TRUE(r.valid);
+    ASSERT_GE(r.inner.size(), 3u);
+    const auto min_over_ellipse = [&](const Vec2& n, int vertex) {
+      const ProjectedVertex& v = r.vertices[vertex];
+      return n.dot(v.mean_px) - scale * std::sqrt(n.dot(v.covariance_px2 * n));
+    };
+    for (std::size_t i = 0; i < r.inner.size(); ++i) {
+      const Vec2 a = r.inner[i], b = r.inner[(i + 1) % r.inner.size()];
+      const Vec2 n = Vec2(b.y() - a.y(), a.x() - b.x()).normalized();  // outward
+      const double offset = n.dot(a);
+      double best = 1e300;
+      for (std::size_t h = 0; h < r.hull.size(); ++h) {
+        const double gap_a = min_over_ellipse(n, r.hull[h]) - offset;
+        const double gap_b = min_over_ellipse(n, r.hull[(h + 1) % r.hull.size()]) - offset;
+        best = std::min(best, std::max(std::abs(gap_a), std::abs(gap_b)));
+      }
+      EXPECT_LT(best, 1e-5) << "edge " << i << " at " << rotation_deg << " deg";
+    }
+  }
 }
 
 // Sample true poses; each projected vertex must fall in the outer region (>= 95%), and the

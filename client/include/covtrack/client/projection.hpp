@@ -74,5 +74,10 @@ std::vector<ProjectedVertex> project_vertices(const Camera& camera,
                                               const UncertainPose& T_camera_object,
                                               std::span<const Vec3> p_object,
                                               const ProjectionOptions& options = {});
+// The same into `out` (cleared first): a caller projecting every frame keeps one vector
+// per object and pays no allocation once its capacity suffices.
+void project_vertices(const Camera& camera, const UncertainPose& T_camera_object,
+                      std::span<const Vec3> p_object, const ProjectionOptions& options,
+                      std::vector<ProjectedVertex>& out);
 
 }  // namespace covtrack::client

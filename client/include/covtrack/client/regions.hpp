@@ -12,7 +12,8 @@
 //    of n . c + sqrt(n^T S n). It contains every ellipse, so each vertex lies in it with
 //    probability >= p. Directions start 45 degrees apart; a gap is split while the corner
 //    of its two lines is farther than max_polygon_error_px from the chord between their
-//    contact points (a chord lies inside the hull), so every corner, hence every point of
+//    contact points and, when one ellipse touches both lines, from that ellipse's point
+//    facing the corner (both lie inside the hull), so every corner, hence every point of
 //    the polygon, is within that distance of the hull. This costs a few dozen support
 //    evaluations per object instead of a hull over every ellipse's polygon (region_outer.cpp).
 //  - Inner region (contraction, 5.5.2): for each edge of the hull of the mean vertices, the
@@ -20,7 +21,9 @@
 //    intersection of the interior half-planes. Where the seed's construction (corners =
 //    intersections of consecutive tangent lines, then their hull) is well formed, the two
 //    are the same polygon; the half-plane form stays right when tangent lines become
-//    redundant or cross, and is empty when the errors swamp the object.
+//    redundant or cross, and is empty when the errors swamp the object. Each tangent is
+//    solved until the two ellipses' supports agree to 1e-7 px; the line is then moved to
+//    the smaller support, so what is left of that error only shrinks the region.
 // Polygons are counter-clockwise in (u, v) arithmetic (positive signed area), no repeated
 // closing vertex.
 #include <span>
@@ -39,6 +42,9 @@ std::vector<int> convex_hull_indices(std::span<const Vec2> points);
 Polygon convex_hull(std::span<const Vec2> points);
 // The part of a convex polygon with normal . x <= offset.
 Polygon clip_half_plane(const Polygon& convex, const Vec2& normal, double offset);
+// The same into `out`, which has room for convex.size() + 1 points; returns the count.
+std::size_t clip_half_plane(std::span<const Vec2> convex, const Vec2& normal, double offset,
+                            Vec2* out);
 // Inside or within tolerance_px of a convex polygon.
 bool polygon_contains(const Polygon& convex, const Vec2& point, double tolerance_px = 1e-9);
 double polygon_area(const Polygon& polygon);
