@@ -1,8 +1,9 @@
 #include "covtrack/devices/fiducial/corner_noise.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <vector>
+#include <cstdint>
 
 #include <opencv2/imgproc.hpp>
 
@@ -31,9 +32,12 @@ double estimate_image_noise(const cv::Mat& gray) {
   CV_Assert(gray.type() == CV_8UC1);
   // The filter [1 -2 1; -2 4 -2; 1 -2 1] cancels any locally planar image and leaves
   // 6 sigma of white noise in its standard deviation; a median needs no edge mask.
+  // Responses are integers in [0, 16 * 255]: a histogram gives the exact median without
+  // storing or partially sorting them (that was most of this function's time).
   constexpr int kStep = 3;
-  std::vector<int> responses;
-  responses.reserve(static_cast<std::size_t>(gray.rows / kStep + 1) * (gray.cols / kStep + 1));
+  constexpr int kMaxResponse = 16 * 255;
+  std::array<std::uint32_t, kMaxResponse + 1> counts{};
+  std::uint32_t n = 0;
   for (int r = 1; r + 1 < gray.rows; r += kStep) {
     const std::uint8_t* a = gray.ptr<std::uint8_t>(r - 1);
     const std::uint8_t* b = gray.ptr<std::uint8_t>(r);
@@ -41,14 +45,17 @@ double estimate_image_noise(const cv::Mat& gray) {
     for (int x = 1; x + 1 < gray.cols; x += kStep) {
       const int v = a[x - 1] - 2 * a[x] + a[x + 1] - 2 * (b[x - 1] - 2 * b[x] + b[x + 1]) +
                     c[x - 1] - 2 * c[x] + c[x + 1];
-      responses.push_back(std::abs(v));
+      ++counts[static_cast<std::size_t>(std::abs(v))];
+      ++n;
     }
   }
-  if (responses.empty()) return 0;
-  auto mid = responses.begin() + static_cast<std::ptrdiff_t>(responses.size() / 2);
-  std::nth_element(responses.begin(), mid, responses.end());
+  if (n == 0) return 0;
+  // The element a sort would put at index n / 2.
+  std::uint32_t seen = 0;
+  int median = 0;
+  while ((seen += counts[static_cast<std::size_t>(median)]) <= n / 2) ++median;
   // For Gaussian noise the median of |N(0, 36 sigma^2)| is 0.6745 * 6 sigma.
-  return *mid / (0.6745 * 6.0);
+  return median / (0.6745 * 6.0);
 }
 
 namespace {
