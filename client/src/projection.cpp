@@ -44,9 +44,10 @@ struct RigidMap {
   }
 };
 
-// The 2n+1 perturbed poses T * Exp(sigma_i) and their weights, shared by all vertices.
+// The 2n perturbed poses T * Exp(+-sigma_i) and the weights, shared by all vertices.
+// Sigma point 0 is the pose itself: its pixel is the vertex's own, projected by the caller.
 struct SigmaPoses {
-  std::array<RigidMap, kSigmaPoints> T;
+  std::array<RigidMap, 2 * kN> T;
   double wm0, wc0, wi;
 };
 
@@ -115,9 +116,7 @@ SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut
   const Mat3 R = pose.T.linear();
   const Vec3 t = pose.T.translation();
   SigmaPoses s;
-  const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  s.T[0] = compose(R, t, I, Vec3::Zero());
-  for (int i = 0; i < kN; ++i) compose_exp_pair(R, t, S.col(i), s.T[1 + i], s.T[1 + kN + i]);
+  for (int i = 0; i < kN; ++i) compose_exp_pair(R, t, S.col(i), s.T[i], s.T[kN + i]);
   s.wm0 = lambda / (kN + lambda);
   s.wc0 = s.wm0 + (1 - ut.alpha * ut.alpha + ut.beta);
   s.wi = 0.5 / (kN + lambda);
@@ -153,7 +152,7 @@ void project_unscented(const Camera& camera, const SigmaPoses& s, const Vec3& p,
   std::array<Vec2, kSigmaPoints> px;
   px[0] = v.mean_px;
   for (int i = 1; i < kSigmaPoints; ++i) {
-    const Vec3 pc = s.T[i](p);
+    const Vec3 pc = s.T[i - 1](p);
     if (pc.z() < o.near_m) {
       v.flags.sigma_point_behind_camera = true;
       return;  // a pixel from behind the camera would poison the sums

@@ -95,6 +95,19 @@ Result<void> run_driver(const FiducialConfig& c, Sink& sink, std::size_t frames)
   return result;
 }
 
+// A device table read as the daemon reads devices.cam of dir/test.toml: the source and
+// calibration keys, then `more_keys`.
+FiducialConfig read_cam_config(const std::string& more_keys, ConfigErrors& errors) {
+  auto toml = parse_toml("type = \"fiducial\"\nsource = \"x.png\"\ncalibration = \"c.yml\"\n" + more_keys,
+                         "test.toml");
+  if (!toml) {
+    ADD_FAILURE() << toml.error().message;
+    return {};
+  }
+  TableReader r(*toml, "devices.cam", fiducial_device_spec(), "dir/test.toml", errors);
+  return read_fiducial_config(r, "cam");
+}
+
 }  // namespace
 
 TEST(FiducialDriver, ReportsEachMappedTagNearItsTruthWithRawDetections) {
@@ -206,12 +219,8 @@ TEST(FiducialDriver, CorruptVideoIsAClearError) {
 }
 
 TEST(FiducialDriver, ConfigErrorsNameTheKey) {
-  auto toml = parse_toml("type = \"fiducial\"\nsource = \"x.png\"\ncalibration = \"c.yml\"\n"
-                         "family = \"tag99\"\n", "test.toml");
-  ASSERT_TRUE(toml.has_value());
   ConfigErrors errors;
-  TableReader r(*toml, "devices.cam", fiducial_device_spec(), "dir/test.toml", errors);
-  const FiducialConfig c = read_fiducial_config(r, "cam");
+  const FiducialConfig c = read_cam_config("family = \"tag99\"\n", errors);
   EXPECT_EQ(c.calibration, "dir/c.yml");  // relative to the config file
   const std::string all = errors.joined();
   EXPECT_NE(all.find("unknown AprilTag family 'tag99'"), std::string::npos) << all;
@@ -219,13 +228,10 @@ TEST(FiducialDriver, ConfigErrorsNameTheKey) {
 }
 
 TEST(FiducialDriver, ImageOptionErrorsNameTheKey) {
-  auto toml = parse_toml("type = \"fiducial\"\nsource = \"x.png\"\ncalibration = \"c.yml\"\n"
-                         "publish_images = \"yes\"\nimage_every_n = 0\nimage_jpeg_quality = 101\n"
-                         "[[tags]]\nid = 1\nsize_m = 0.1\n", "test.toml");
-  ASSERT_TRUE(toml.has_value());
   ConfigErrors errors;
-  TableReader r(*toml, "devices.cam", fiducial_device_spec(), "dir/test.toml", errors);
-  const FiducialConfig c = read_fiducial_config(r, "cam");
+  const FiducialConfig c = read_cam_config("publish_images = \"yes\"\nimage_every_n = 0\nimage_jpeg_quality = 101\n"
+                                           "[[tags]]\nid = 1\nsize_m = 0.1\n",
+                                           errors);
   const std::string all = errors.joined();
   EXPECT_NE(all.find("devices.cam.publish_images"), std::string::npos) << all;
   EXPECT_NE(all.find("devices.cam.image_every_n"), std::string::npos) << all;
@@ -233,13 +239,10 @@ TEST(FiducialDriver, ImageOptionErrorsNameTheKey) {
   EXPECT_EQ(errors.list().size(), 3u) << all;
   EXPECT_GE(c.image_every_n, 1);  // a usable value even when the key is wrong
 
-  auto good = parse_toml("type = \"fiducial\"\nsource = \"x.png\"\ncalibration = \"c.yml\"\n"
-                         "publish_images = true\nimage_every_n = 5\nimage_jpeg_quality = 60\n"
-                         "[[tags]]\nid = 1\nsize_m = 0.1\n", "test.toml");
-  ASSERT_TRUE(good.has_value());
   ConfigErrors none;
-  TableReader g(*good, "devices.cam", fiducial_device_spec(), "dir/test.toml", none);
-  const FiducialConfig d = read_fiducial_config(g, "cam");
+  const FiducialConfig d = read_cam_config("publish_images = true\nimage_every_n = 5\nimage_jpeg_quality = 60\n"
+                                           "[[tags]]\nid = 1\nsize_m = 0.1\n",
+                                           none);
   EXPECT_TRUE(none.empty()) << none.joined();
   EXPECT_TRUE(d.publish_images);
   EXPECT_EQ(d.image_every_n, 5);

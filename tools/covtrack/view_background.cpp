@@ -18,7 +18,9 @@ std::optional<cv::Scalar> parse_colour(const std::string& spec) {
   return std::nullopt;
 }
 
-cv::Mat fit(const cv::Mat& frame, cv::Size size) {
+}  // namespace
+
+cv::Mat fit_to_view(const cv::Mat& frame, cv::Size size) {
   cv::Mat out;
   if (frame.size() == size) {
     out = frame.clone();
@@ -28,8 +30,6 @@ cv::Mat fit(const cv::Mat& frame, cv::Size size) {
   if (out.channels() == 1) cv::cvtColor(out, out, cv::COLOR_GRAY2BGR);
   return out;
 }
-
-}  // namespace
 
 ViewBackground::ViewBackground(const std::string& spec, cv::Size size, std::string& warning)
     : size_(size), name_(spec) {
@@ -48,7 +48,7 @@ ViewBackground::ViewBackground(const std::string& spec, cv::Size size, std::stri
       warning = fmt::format("background {}: no such file; drawing on a plain background", spec);
       return;
     } else if (cv::Mat image = cv::imread(spec, cv::IMREAD_COLOR); !image.empty()) {
-      still_ = fit(image, size_);
+      still_ = fit_to_view(image, size_);
       return;
     } else {
       video_.emplace(spec, cv::CAP_FFMPEG);  // not every backend in turn, each complaining
@@ -76,7 +76,7 @@ cv::Mat ViewBackground::next(std::string& warning) {
     } catch (const cv::Exception& e) {
       frame.release();
     }
-    if (!frame.empty()) return fit(frame, size_);
+    if (!frame.empty()) return fit_to_view(frame, size_);
     warning = fmt::format("background {}: no more frames (corrupt or unplugged); drawing on a plain background",
                           name_);
     video_.reset();

@@ -10,6 +10,9 @@
 
 namespace covtrack::cli {
 
+// `frame` at the view's size, 8-bit BGR: a copy the caller may draw on.
+cv::Mat fit_to_view(const cv::Mat& frame, cv::Size size);
+
 class ViewBackground {
  public:
   // spec: "#rrggbb", "camera:N", or an image or video file. Problems go to `warning`.

@@ -16,7 +16,6 @@
 #include <vector>
 
 #include <opencv2/highgui.hpp>
-#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include <fmt/format.h>
@@ -68,14 +67,6 @@ std::vector<std::string> legend_lines(const RegionsModel& model, const LatestRep
     lines.push_back(fmt::format("{} -> {} [{}]: {}", t.parent, t.child, t.stream->key(), state));
   }
   return lines;
-}
-
-// A recorded camera frame as the view's background: the view's size, a copy to draw on.
-cv::Mat fitted_to(const cv::Mat& frame, cv::Size size) {
-  if (frame.size() == size) return frame.clone();
-  cv::Mat out;
-  cv::resize(frame, out, size);
-  return out;
 }
 
 // What the pointer does now, for the legend.
@@ -182,7 +173,7 @@ int run_view(const ViewArgs& args) {
     // A log's own camera frames are the background unless --background names another.
     cv::Mat image;
     if (log && args.background.empty())
-      if (const cv::Mat& frame = log->image(warning); !frame.empty()) image = fitted_to(frame, size);
+      if (const cv::Mat& frame = log->image(warning); !frame.empty()) image = fit_to_view(frame, size);
     if (image.empty()) image = background.next(warning);
     if (!warning.empty()) {
       std::cerr << "covtrack view: " << warning << "\n";

@@ -6,6 +6,12 @@
 
 namespace covtrack::cli {
 
+client::Vec2 label_box_px(const std::string& text) {
+  int baseline = 0;
+  const cv::Size size = cv::getTextSize(text, kLabelFont, kLabelFontScale, 1, &baseline);
+  return {size.width + 2 * kLabelPad, size.height + baseline + 2 * kLabelPad};
+}
+
 ViewLabels layout_labels(const RegionsReport& report, const WidgetFrame* widgets, const cv::Size& screen) {
   ViewLabels out;
   std::vector<client::LabelRequest> requests;
@@ -13,9 +19,7 @@ ViewLabels layout_labels(const RegionsReport& report, const WidgetFrame* widgets
     const RegionsReport::Object& o = report.objects[i];
     const client::ObjectRegions& r = o.regions;
     std::string text = r.valid ? fmt::format("{} {:.1f}px", o.name, r.assessment) : fmt::format("{}: no region", o.name);
-    int baseline = 0;
-    const cv::Size size = cv::getTextSize(text, kLabelFont, kLabelFontScale, 1, &baseline);
-    const client::Vec2 box(size.width + 2 * kLabelPad, size.height + baseline + 2 * kLabelPad);
+    const client::Vec2 box = label_box_px(text);
     const bool listed = widgets && widgets->augmentations[i] == scene::Augmentation::label;
     requests.push_back(listed ? client::LabelRequest{{}, {}, box} : client::LabelRequest{r.inner, r.outer, box});
     out.texts.push_back(std::move(text));

@@ -28,4 +28,7 @@ inline constexpr int kLabelFont = 0;  // cv::FONT_HERSHEY_SIMPLEX
 inline constexpr double kLabelFontScale = 0.45;
 inline constexpr int kLabelPad = 2;
 
+// The box (px) a label with this text needs: the text plus kLabelPad on every side.
+client::Vec2 label_box_px(const std::string& text);
+
 }  // namespace covtrack::cli

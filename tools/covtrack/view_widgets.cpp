@@ -2,8 +2,6 @@
 
 #include <algorithm>
 
-#include <opencv2/imgproc.hpp>
-
 #include <fmt/format.h>
 
 #include "view_labels.hpp"
@@ -50,11 +48,9 @@ WidgetFrame ViewWidgets::update(const RegionsReport& report, const cv::Size& scr
     client::IndirectOptions options;
     options.screen = {client::Vec2(0, 0), client::Vec2(screen.width, screen.height)};
     // Wide enough for the longest candidate's name: a cut name cannot be told apart.
-    for (int object : frame.selection.candidates) {
-      const std::string& name = report.objects[static_cast<std::size_t>(object)].name;
-      const double width = cv::getTextSize(name, kLabelFont, kLabelFontScale, 1, nullptr).width + 2 * kLabelPad;
-      options.target_size_px.x() = std::max(options.target_size_px.x(), width);
-    }
+    for (int object : frame.selection.candidates)
+      options.target_size_px.x() = std::max(options.target_size_px.x(),
+                                            label_box_px(report.objects[static_cast<std::size_t>(object)].name).x());
     frame.targets = client::layout_indirect_targets(frame.selection.candidates, *frame.pointer, options);
   }
   return frame;

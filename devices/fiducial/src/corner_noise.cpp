@@ -28,6 +28,12 @@ double CornerNoiseModel::narrow_sigma_px(double quiet_band_px) const {
   return narrow_px * std::pow(kNarrowBandPx / band, narrow_power / 2);
 }
 
+std::array<double, 4> CornerNoiseModel::narrow_sigmas_px(const std::array<double, 4>& corner_band_px) const {
+  std::array<double, 4> sigmas{};
+  for (std::size_t k = 0; k < 4; ++k) sigmas[k] = narrow_sigma_px(corner_band_px[k]);
+  return sigmas;
+}
+
 double estimate_image_noise(const cv::Mat& gray) {
   CV_Assert(gray.type() == CV_8UC1);
   // The filter [1 -2 1; -2 4 -2; 1 -2 1] cancels any locally planar image and leaves

@@ -111,9 +111,8 @@ class FiducialDriver final : public Driver {
       const double sigma = config_.noise.sigma_px(raw.image_noise, contrast,
                                                   mean_edge_length_px(det.corners_px),
                                                   edge_axis_alignment(det.corners_px));
-      CornerNoise noise{sigma, config_.noise.radial_bias_px, config_.noise.radial_sigma_px, {}};
-      const auto band = corner_quiet_band_px(det.corners_px, cells, quiet_cells_);
-      for (std::size_t k = 0; k < 4; ++k) noise.narrow_px[k] = config_.noise.narrow_sigma_px(band[k]);
+      const CornerNoise noise{sigma, config_.noise.radial_bias_px, config_.noise.radial_sigma_px,
+                              config_.noise.narrow_sigmas_px(corner_quiet_band_px(det.corners_px, cells, quiet_cells_))};
       auto pose = estimate_tag_pose(camera_, det.corners_px, size->second, noise, config_.ambiguity_chi2);
       if (!pose) {
         sink.count_error(fmt::format("tag {}: {}", det.id, pose.error().message));

@@ -79,10 +79,8 @@ Result<std::vector<ViewDraw>> draw_view(const CameraModel& camera, const Detecto
 }
 
 CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& d) {
-  CornerNoise n{model.sigma_px(d.image_noise, d.contrast, d.edge_length_px, d.axis_alignment),
-                model.radial_bias_px, model.radial_sigma_px, {}};
-  for (std::size_t k = 0; k < 4; ++k) n.narrow_px[k] = model.narrow_sigma_px(d.corner_band_px[k]);
-  return n;
+  return {model.sigma_px(d.image_noise, d.contrast, d.edge_length_px, d.axis_alignment),
+          model.radial_bias_px, model.radial_sigma_px, model.narrow_sigmas_px(d.corner_band_px)};
 }
 
 double mean_pose_nees(const CameraModel& camera, const CalibrationView& view,

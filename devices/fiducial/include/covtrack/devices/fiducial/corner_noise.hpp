@@ -43,6 +43,8 @@ struct CornerNoiseModel {
   // The extra standard deviation (px) of a corner whose narrower edge has a quiet band
   // of `quiet_band_px`: narrow_px * (kNarrowBandPx / band)^(power / 2).
   double narrow_sigma_px(double quiet_band_px) const;
+  // The same for the four corners (corner_quiet_band_px).
+  std::array<double, 4> narrow_sigmas_px(const std::array<double, 4>& corner_band_px) const;
   static constexpr double kNarrowBandPx = 4;
 
   // One corner coordinate's standard deviation (px), the same along u and v.
