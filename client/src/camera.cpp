@@ -12,11 +12,11 @@ namespace covtrack::client {
 Vec2 Camera::project(const Vec3& p, Mat23* J_pixel_point) const {
   const double iz = 1.0 / p.z();
   const double x = p.x() * iz, y = p.y() * iz;
-  const double r2 = x * x + y * y;
-  const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  const double xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
-  const double yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
+  Vec2 pixel;
+  pixel_of_normalised(x, y, pixel.x(), pixel.y());
   if (J_pixel_point) {
+    const double r2 = x * x + y * y;
+    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
     // Chain rule: pixel <- distorted (xd, yd) <- normalised (x, y) <- point.
     const double dradial_dr2 = k1 + r2 * (2 * k2 + 3 * k3 * r2);
     const double drad_dx = 2 * x * dradial_dr2, drad_dy = 2 * y * dradial_dr2;
@@ -31,13 +31,13 @@ Vec2 Camera::project(const Vec3& p, Mat23* J_pixel_point) const {
     F << fx, 0, 0, fy;
     *J_pixel_point = F * D * N;
   }
-  return {fx * xd + cx, fy * yd + cy};
+  return pixel;
 }
 
-Mat2 Camera::intrinsic_covariance(const Vec3& p) const {
+Mat2 Camera::intrinsic_covariance_at(const Vec2& pixel) const {
   if (intrinsic_sigmas_px.isZero()) return Mat2::Zero();
   // u = fx xd + cx, v = fy yd + cy: d(u,v)/d(fx,fy,cx,cy) = [xd 0 1 0; 0 yd 0 1].
-  const Vec2 centred = project(p) - Vec2(cx, cy);
+  const Vec2 centred = pixel - Vec2(cx, cy);
   Eigen::Matrix<double, 2, 4> J;
   J << centred.x() / fx, 0, 1, 0, 0, centred.y() / fy, 0, 1;
   const Eigen::Vector4d var = intrinsic_sigmas_px.cwiseAbs2();

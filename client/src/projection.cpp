@@ -1,10 +1,13 @@
 #include "covtrack/client/projection.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+
+#include "vector_clones.hpp"
 
 namespace covtrack::client {
 
@@ -44,10 +47,9 @@ struct RigidMap {
   }
 };
 
-// The 2n perturbed poses T * Exp(+-sigma_i) and the weights, shared by all vertices.
-// Sigma point 0 is the pose itself: its pixel is the vertex's own, projected by the caller.
+// The 2n+1 sigma poses T * Exp(+-sigma_i), T[0] = T, and the weights, shared by all vertices.
 struct SigmaPoses {
-  std::array<RigidMap, 2 * kN> T;
+  std::array<RigidMap, kSigmaPoints> T;
   double wm0, wc0, wi;
 };
 
@@ -74,10 +76,15 @@ void compose_exp_pair(const Mat3& R0, const Vec3& t0, const Vec6& xi, RigidMap& 
   const Vec3 rho = xi.head<3>(), phi = xi.tail<3>();
   const double t2 = phi.squaredNorm();
   double a, b, c;
-  if (t2 < 1e-4) {  // theta < 1e-2: series, error below theta^6/5040 (c would cancel)
-    a = 1 - t2 / 6 * (1 - t2 / 20);
-    b = 0.5 - t2 / 24 * (1 - t2 / 30);
-    c = 1.0 / 6 - t2 / 120 * (1 - t2 / 42);
+  if (t2 < 0.09) {
+    // theta < 0.3 rad (sigma points of rotation sigmas up to 10 degrees): the Taylor series
+    // to theta^10, in Horner form with constant coefficients (multiplications, no
+    // divisions). The next terms are below 1e-16: as exact as sin and cos, and no
+    // cancellation in c. Coefficients: (-1)^k / (2k+1)!, / (2k+2)!, / (2k+3)!.
+    const double t = t2;
+    a = 1 + t * (-1 / 6. + t * (1 / 120. + t * (-1 / 5040. + t * (1 / 362880. + t * (-1 / 39916800.)))));
+    b = 1 / 2. + t * (-1 / 24. + t * (1 / 720. + t * (-1 / 40320. + t * (1 / 3628800. + t * (-1 / 479001600.)))));
+    c = 1 / 6. + t * (-1 / 120. + t * (1 / 5040. + t * (-1 / 362880. + t * (1 / 39916800. + t * (-1 / 6227020800.)))));
   } else {
     const double theta = std::sqrt(t2), inv = 1 / theta;
     const double sn = std::sin(theta), cs = std::cos(theta);
@@ -116,7 +123,9 @@ SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut
   const Mat3 R = pose.T.linear();
   const Vec3 t = pose.T.translation();
   SigmaPoses s;
-  for (int i = 0; i < kN; ++i) compose_exp_pair(R, t, S.col(i), s.T[i], s.T[kN + i]);
+  const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  s.T[0] = compose(R, t, identity, Vec3::Zero());
+  for (int i = 0; i < kN; ++i) compose_exp_pair(R, t, S.col(i), s.T[1 + i], s.T[1 + kN + i]);
   s.wm0 = lambda / (kN + lambda);
   s.wc0 = s.wm0 + (1 - ut.alpha * ut.alpha + ut.beta);
   s.wi = 0.5 / (kN + lambda);
@@ -146,29 +155,101 @@ Mat2 repair_psd(const Mat2& C, bool& repaired) {
          eig.eigenvectors().transpose();
 }
 
-// `v` holds the unperturbed vertex's pixel (sigma point 0: the pose itself).
-void project_unscented(const Camera& camera, const SigmaPoses& s, const Vec3& p,
-                       const ProjectionOptions& o, ProjectedVertex& v) {
-  std::array<Vec2, kSigmaPoints> px;
-  px[0] = v.mean_px;
-  for (int i = 1; i < kSigmaPoints; ++i) {
-    const Vec3 pc = s.T[i - 1](p);
-    if (pc.z() < o.near_m) {
-      v.flags.sigma_point_behind_camera = true;
-      return;  // a pixel from behind the camera would poison the sums
+// Vertices go through the unscented transform in blocks: every sigma point of kBlock
+// vertices in loops of fixed length over structure-of-arrays data, which vectorise
+// (vector_clones.hpp). A short last block repeats its first vertex.
+constexpr int kBlock = 8;
+
+struct UnscentedBlock {
+  double u0[kBlock], v0[kBlock];  // pixel of the unperturbed vertex (sigma point 0)
+  double z0[kBlock];              // its camera depth
+  double zmin[kBlock];            // the nearest depth over all sigma points
+  double mean_u[kBlock], mean_v[kBlock];
+  double cuu[kBlock], cuv[kBlock], cvv[kBlock];
+};
+
+COVTRACK_VECTOR_CLONES
+void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&px)[kBlock],
+                     const double (&py)[kBlock], const double (&pz)[kBlock], UnscentedBlock& out) {
+  // Local copies: the compiler need not fear that a store through `out` changes them.
+  const Camera cam = camera;
+  const double wm0 = s.wm0, wc0 = s.wc0, wi = s.wi;
+  double u[kSigmaPoints][kBlock], v[kSigmaPoints][kBlock], zmin[kBlock], z0[kBlock];
+  for (int j = 0; j < kBlock; ++j) {
+    const RigidMap& m = s.T[0];
+    z0[j] = zmin[j] = m.r[6] * px[j] + m.r[7] * py[j] + m.r[8] * pz[j] + m.t[2];
+  }
+  for (int i = 0; i < kSigmaPoints; ++i) {
+    const RigidMap m = s.T[i];
+    for (int j = 0; j < kBlock; ++j) {
+      const double x = m.r[0] * px[j] + m.r[1] * py[j] + m.r[2] * pz[j] + m.t[0];
+      const double y = m.r[3] * px[j] + m.r[4] * py[j] + m.r[5] * pz[j] + m.t[1];
+      const double z = m.r[6] * px[j] + m.r[7] * py[j] + m.r[8] * pz[j] + m.t[2];
+      // A point behind the camera gives a meaningless pixel here; the caller checks zmin.
+      const double iz = 1 / z;
+      cam.pixel_of_normalised(x * iz, y * iz, u[i][j], v[i][j]);
+      zmin[j] = std::min(zmin[j], z);
     }
-    px[i] = camera.project(pc);
   }
-  Vec2 mean = s.wm0 * px[0];
-  for (int i = 1; i < kSigmaPoints; ++i) mean += s.wi * px[i];
-  Vec2 d = px[0] - mean;
-  Mat2 cov = s.wc0 * d * d.transpose();
-  for (int i = 1; i < kSigmaPoints; ++i) {
-    d = px[i] - mean;
-    cov += s.wi * d * d.transpose();
+  double mu[kBlock], mv[kBlock], cuu[kBlock], cuv[kBlock], cvv[kBlock];
+  for (int j = 0; j < kBlock; ++j) mu[j] = wm0 * u[0][j], mv[j] = wm0 * v[0][j];
+  for (int i = 1; i < kSigmaPoints; ++i)
+    for (int j = 0; j < kBlock; ++j) mu[j] += wi * u[i][j], mv[j] += wi * v[i][j];
+  for (int j = 0; j < kBlock; ++j) {
+    const double du = u[0][j] - mu[j], dv = v[0][j] - mv[j];
+    cuu[j] = wc0 * du * du, cuv[j] = wc0 * du * dv, cvv[j] = wc0 * dv * dv;
   }
-  v.mean_px = mean;
-  v.covariance_px2 = repair_psd(cov, v.flags.covariance_repaired);
+  for (int i = 1; i < kSigmaPoints; ++i)
+    for (int j = 0; j < kBlock; ++j) {
+      const double du = u[i][j] - mu[j], dv = v[i][j] - mv[j];
+      cuu[j] += wi * du * du, cuv[j] += wi * du * dv, cvv[j] += wi * dv * dv;
+    }
+  for (int j = 0; j < kBlock; ++j) {
+    out.u0[j] = u[0][j], out.v0[j] = v[0][j], out.z0[j] = z0[j], out.zmin[j] = zmin[j];
+    out.mean_u[j] = mu[j], out.mean_v[j] = mv[j];
+    out.cuu[j] = cuu[j], out.cuv[j] = cuv[j], out.cvv[j] = cvv[j];
+  }
+}
+
+}  // namespace
+
+namespace {
+
+void project_unscented(const Camera& camera, const UncertainPose& pose,
+                       std::span<const Vec3> points, const ProjectionOptions& o,
+                       const ProjectionFlags& shared, std::vector<ProjectedVertex>& out) {
+  const SigmaPoses sigma = make_sigma_poses(pose, o.unscented);
+  UnscentedBlock b;
+  for (std::size_t first = 0; first < points.size(); first += kBlock) {
+    const int count = static_cast<int>(std::min<std::size_t>(kBlock, points.size() - first));
+    double px[kBlock], py[kBlock], pz[kBlock];
+    for (int j = 0; j < kBlock; ++j) {
+      const Vec3& p = points[first + (j < count ? j : 0)];
+      px[j] = p.x(), py[j] = p.y(), pz[j] = p.z();
+    }
+    unscented_block(camera, sigma, px, py, pz, b);
+    for (int j = 0; j < count; ++j) {
+      ProjectedVertex& v = out.emplace_back();
+      v.depth_m = b.z0[j];
+      v.flags = shared;
+      if (b.z0[j] < o.near_m) {
+        v.flags.behind_camera = true;
+        continue;
+      }
+      v.mean_px = Vec2(b.u0[j], b.v0[j]);
+      if (b.zmin[j] < o.near_m) {
+        // A pixel from behind the camera would poison the sums: no covariance.
+        v.flags.sigma_point_behind_camera = true;
+        continue;
+      }
+      const Vec2 unperturbed = v.mean_px;
+      v.mean_px = Vec2(b.mean_u[j], b.mean_v[j]);
+      Mat2 C;
+      C << b.cuu[j], b.cuv[j], b.cuv[j], b.cvv[j];
+      v.covariance_px2 = repair_psd(C, v.flags.covariance_repaired);
+      if (o.add_intrinsic_uncertainty) v.covariance_px2 += camera.intrinsic_covariance_at(unperturbed);
+    }
+  }
 }
 
 }  // namespace
@@ -179,31 +260,28 @@ void project_vertices(const Camera& camera, const UncertainPose& pose,
   out.clear();
   // An unbounded pose has no covariance to transform (it may hold infinities).
   const bool use_covariance = !pose.unbounded;
-  const bool rot_flag =
+  ProjectionFlags shared;
+  shared.unbounded = pose.unbounded;
+  shared.rotation_too_uncertain =
       use_covariance && rotation_too_uncertain(pose.covariance, o.max_rotation_sigma_rad);
-  const bool unscented = o.method == ProjectionMethod::unscented && use_covariance;
-  SigmaPoses sigma;
-  if (unscented) sigma = make_sigma_poses(pose, o.unscented);
+  if (o.method == ProjectionMethod::unscented && use_covariance)
+    return project_unscented(camera, pose, points, o, shared, out);
 
   for (const Vec3& p : points) {
     ProjectedVertex& v = out.emplace_back();
     const Vec3 pc = pose.T * p;
     v.depth_m = pc.z();
-    v.flags.unbounded = pose.unbounded;
-    v.flags.rotation_too_uncertain = rot_flag;
+    v.flags = shared;
     if (pc.z() < o.near_m) {
       v.flags.behind_camera = true;
       continue;
     }
     v.mean_px = camera.project(pc);
-    if (unscented) {
-      project_unscented(camera, sigma, p, o, v);
-    } else if (use_covariance) {
+    if (use_covariance) {
       const Mat26 J = pixel_jacobian_wrt_perturbation(camera, pose.T, p);
       v.covariance_px2 = J * pose.covariance * J.transpose();
+      if (o.add_intrinsic_uncertainty) v.covariance_px2 += camera.intrinsic_covariance_at(v.mean_px);
     }
-    if (o.add_intrinsic_uncertainty && v.flags.usable())
-      v.covariance_px2 += camera.intrinsic_covariance(pc);
   }
 }
 

@@ -4,35 +4,50 @@
 
 namespace covtrack::client {
 
-ObjectRegions compute_object_regions(const Camera& camera, const UncertainPose& T_camera_object,
-                                     std::span<const Vec3> vertices_object,
-                                     const ObjectRegionOptions& o) {
-  ObjectRegions r;
-  r.vertices = project_vertices(camera, T_camera_object, vertices_object, o.projection);
+void compute_object_regions(const Camera& camera, const UncertainPose& T_camera_object,
+                            std::span<const Vec3> vertices_object, const ObjectRegionOptions& o,
+                            ObjectRegions& r) {
+  project_vertices(camera, T_camera_object, vertices_object, o.projection, r.vertices);
+  r.flags = {};
   r.valid = !r.vertices.empty();
   for (const ProjectedVertex& v : r.vertices) {
     r.flags |= v.flags;
     r.valid = r.valid && v.flags.usable();
   }
+  r.outer.clear();
+  r.inner.clear();
   if (!r.valid) {
+    r.hull.clear();
     r.assessment = std::numeric_limits<double>::infinity();
-    return r;
+    return;
   }
 
-  std::vector<Vec2> means;
-  means.reserve(r.vertices.size());
+  // Scratch kept per thread: a frame of many objects allocates nothing. The hull's buffer
+  // is taken out of its pool while in use, because the assessment runs user code that
+  // may compute regions itself (it then finds the pool empty and allocates its own).
+  thread_local std::vector<Vec2> means;
+  thread_local std::vector<ProjectedVertex> hull_pool;
+  std::vector<ProjectedVertex> hull = std::move(hull_pool);
+  means.clear();
   for (const ProjectedVertex& v : r.vertices) means.push_back(v.mean_px);
-  r.hull = convex_hull_indices(means);
-  std::vector<ProjectedVertex> hull;
-  hull.reserve(r.hull.size());
+  convex_hull_indices(means, r.hull);
+  hull.clear();
   for (int i : r.hull) hull.push_back(r.vertices[i]);
 
   // Every vertex's ellipse goes into the outer region, not only the hull's: a vertex just
   // inside the mean hull can still stick out once perturbed. The inner region needs only
   // the hull (a subset of the true vertices spans less, so it stays conservative).
-  r.outer = expand_region(r.vertices, o.regions);
-  r.inner = contract_region(hull, o.regions);
+  expand_region(r.vertices, o.regions, r.outer);
+  contract_region(hull, o.regions, r.inner);
   r.assessment = assess(o.assessment, hull);
+  hull_pool = std::move(hull);
+}
+
+ObjectRegions compute_object_regions(const Camera& camera, const UncertainPose& T_camera_object,
+                                     std::span<const Vec3> vertices_object,
+                                     const ObjectRegionOptions& o) {
+  ObjectRegions r;
+  compute_object_regions(camera, T_camera_object, vertices_object, o, r);
   return r;
 }
 

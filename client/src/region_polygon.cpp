@@ -10,18 +10,20 @@ double cross(const Vec2& o, const Vec2& a, const Vec2& b) {
 }
 }  // namespace
 
-std::vector<int> convex_hull_indices(std::span<const Vec2> p) {
+void convex_hull_indices(std::span<const Vec2> p, std::vector<int>& h) {
   const int n = static_cast<int>(p.size());
-  std::vector<int> idx(n);
+  thread_local std::vector<int> idx;  // kept per thread: no allocation per object
+  idx.resize(n);
   std::iota(idx.begin(), idx.end(), 0);
   std::sort(idx.begin(), idx.end(), [&](int a, int b) {
     return p[a].x() < p[b].x() || (p[a].x() == p[b].x() && p[a].y() < p[b].y());
   });
   if (n < 3) {
-    if (n == 2 && p[idx[0]] == p[idx[1]]) idx.pop_back();
-    return idx;
+    h.assign(idx.begin(), idx.end());
+    if (n == 2 && p[idx[0]] == p[idx[1]]) h.pop_back();
+    return;
   }
-  std::vector<int> h(2 * n);
+  h.resize(2 * n);
   int k = 0;
   for (int i = 0; i < n; ++i) {  // lower chain
     while (k >= 2 && cross(p[h[k - 2]], p[h[k - 1]], p[idx[i]]) <= 0) --k;
@@ -32,7 +34,12 @@ std::vector<int> convex_hull_indices(std::span<const Vec2> p) {
     h[k++] = idx[i];
   }
   h.resize(std::max(k - 1, 1));
-  return h;
+}
+
+std::vector<int> convex_hull_indices(std::span<const Vec2> points) {
+  std::vector<int> hull;
+  convex_hull_indices(points, hull);
+  return hull;
 }
 
 namespace {

@@ -201,6 +201,37 @@ TEST(Projection, IntrinsicSigmasAddCovariance) {
   EXPECT_LT(added(0, 0), 1.0 + 4.0);
 }
 
+// Vertices are projected 8 at a time: 19 vertices (two full blocks and a short one) give
+// each vertex exactly what it gets alone, flags included, whatever its neighbours.
+TEST(Projection, BlocksGiveWhatEachVertexGetsAlone) {
+  const Camera cam = test::example_camera();
+  const UncertainPose pose{pose_from(Vec3(0.05, -0.02, 0.5), Eigen::Quaterniond::Identity()),
+                           covariance(0.01, 3 * kDeg), false};
+  std::vector<Vec3> points;
+  for (int k = 0; k < 19; ++k)
+    points.emplace_back(0.02 * (k % 5) - 0.04, 0.015 * (k % 3), 0.03 * (k % 4));
+  points[9] = Vec3(0, 0, -0.6);    // behind the camera
+  points[17] = Vec3(0, 0, -0.485);  // 1.5 cm in front, 1 cm sigma: some sigma points behind
+  const std::vector<ProjectedVertex> all = project_vertices(cam, pose, points);
+  ASSERT_EQ(all.size(), points.size());
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const ProjectedVertex alone = project_vertex(cam, pose, points[k]);
+    EXPECT_EQ(all[k].mean_px, alone.mean_px) << "vertex " << k;
+    EXPECT_EQ(all[k].covariance_px2, alone.covariance_px2) << "vertex " << k;
+    EXPECT_EQ(all[k].depth_m, alone.depth_m) << "vertex " << k;
+    EXPECT_EQ(all[k].flags.behind_camera, k == 9) << "vertex " << k;
+    EXPECT_EQ(all[k].flags.sigma_point_behind_camera, k == 17) << "vertex " << k;
+    EXPECT_EQ(all[k].flags.usable(), k != 9 && k != 17) << "vertex " << k;
+  }
+  // And what the plain unscented transform gives, block by block.
+  ProjectionOptions o;
+  o.add_intrinsic_uncertainty = false;
+  const std::vector<ProjectedVertex> bare = project_vertices(cam, pose, points, o);
+  for (std::size_t k : {0u, 8u, 16u, 18u})
+    EXPECT_LT(relative_frobenius(bare[k].covariance_px2, reference_unscented(cam, pose, points[k])), 1e-9)
+        << "vertex " << k;
+}
+
 TEST(ProjectionFlags, BehindCamera) {
   const Camera cam = test::example_camera();
   const UncertainPose pose{pose_from(Vec3(0, 0, -1), Eigen::Quaterniond::Identity()),

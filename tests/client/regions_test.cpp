@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -212,32 +213,85 @@ TEST(Regions, NestingInnerInHullInOuter) {
 }
 
 // Each edge of the inner region lies on a line tangent to the confidence ellipses of two
-// adjacent hull vertices, both on its outer side (seed 5.5.2), not merely near one.
+// adjacent hull vertices (to 1e-5 px), both on its outer side.
+void expect_inner_edges_are_interior_tangents(const ObjectRegions& r, const std::string& what) {
+  const double scale = confidence_scale(0.95);
+  ASSERT_TRUE(r.valid) << what;
+  ASSERT_GE(r.inner.size(), 3u) << what;
+  const auto min_over_ellipse = [&](const Vec2& n, int vertex) {
+    const ProjectedVertex& v = r.vertices[vertex];
+    return n.dot(v.mean_px) - scale * std::sqrt(n.dot(v.covariance_px2 * n));
+  };
+  for (std::size_t i = 0; i < r.inner.size(); ++i) {
+    const Vec2 a = r.inner[i], b = r.inner[(i + 1) % r.inner.size()];
+    const Vec2 n = Vec2(b.y() - a.y(), a.x() - b.x()).normalized();  // outward
+    const double offset = n.dot(a);
+    double best = 1e300;
+    for (std::size_t h = 0; h < r.hull.size(); ++h) {
+      const double gap_a = min_over_ellipse(n, r.hull[h]) - offset;
+      const double gap_b = min_over_ellipse(n, r.hull[(h + 1) % r.hull.size()]) - offset;
+      best = std::min(best, std::max(std::abs(gap_a), std::abs(gap_b)));
+    }
+    EXPECT_LT(best, 1e-5) << "edge " << i << " of " << what;
+  }
+}
+
 TEST(Regions, InnerEdgesAreInteriorTangents) {
   const Camera cam = test::example_camera();
-  const double scale = confidence_scale(0.95);
-  for (double rotation_deg : {0.5, 1.0, 2.0}) {
-    const ObjectRegions r = compute_object_regions(cam, box_pose(0.003, rotation_deg * kDeg),
-                                                   box_vertices(0.2, 0.15, 0.1));
-    ASSERT_TRUE(r.valid);
-    ASSERT_GE(r.inner.size(), 3u);
-    const auto min_over_ellipse = [&](const Vec2& n, int vertex) {
-      const ProjectedVertex& v = r.vertices[vertex];
-      return n.dot(v.mean_px) - scale * std::sqrt(n.dot(v.covariance_px2 * n));
-    };
-    for (std::size_t i = 0; i < r.inner.size(); ++i) {
-      const Vec2 a = r.inner[i], b = r.inner[(i + 1) % r.inner.size()];
-      const Vec2 n = Vec2(b.y() - a.y(), a.x() - b.x()).normalized();  // outward
-      const double offset = n.dot(a);
-      double best = 1e300;
-      for (std::size_t h = 0; h < r.hull.size(); ++h) {
-        const double gap_a = min_over_ellipse(n, r.hull[h]) - offset;
-        const double gap_b = min_over_ellipse(n, r.hull[(h + 1) % r.hull.size()]) - offset;
-        best = std::min(best, std::max(std::abs(gap_a), std::abs(gap_b)));
-      }
-      EXPECT_LT(best, 1e-5) << "edge " << i << " at " << rotation_deg << " deg";
-    }
+  for (double rotation_deg : {0.5, 1.0, 2.0})
+    expect_inner_edges_are_interior_tangents(
+        compute_object_regions(cam, box_pose(0.003, rotation_deg * kDeg), box_vertices(0.2, 0.15, 0.1)),
+        std::to_string(rotation_deg) + " deg");
+}
+
+// The tangents are solved 8 hull edges at a time: a 13-gon needs a full block and a short one.
+TEST(Regions, InnerEdgesAreInteriorTangentsBeyondOneBlock) {
+  const Camera cam = test::example_camera();
+  std::vector<Vec3> polygon;
+  for (int k = 0; k < 13; ++k) {
+    const double a = 2 * std::numbers::pi * k / 13;
+    polygon.emplace_back(0.15 * std::cos(a), 0.1 * std::sin(a), 0.02 * (k % 2));
   }
+  const ObjectRegions r = compute_object_regions(cam, box_pose(0.002, 0.5 * kDeg), polygon);
+  ASSERT_EQ(r.hull.size(), 13u);
+  expect_inner_edges_are_interior_tangents(r, "a 13-gon");
+  // Every edge of the hull contributes: the inner region has 13 corners.
+  EXPECT_EQ(r.inner.size(), 13u);
+}
+
+// An application keeps one ObjectRegions per object and recomputes it in place: nothing of
+// an earlier object may survive into the next result.
+TEST(Regions, RecomputedInPlaceEqualsAFreshResult) {
+  const Camera cam = test::example_camera();
+  std::vector<Vec3> big;
+  for (int k = 0; k < 20; ++k)
+    big.emplace_back(0.2 * std::cos(0.3 * k), 0.15 * std::sin(0.3 * k), 0.01 * k);
+  UncertainPose behind = box_pose(0.005, 1 * kDeg);
+  behind.T.translation().z() = -1;
+  const auto box = box_vertices(0.2, 0.15, 0.1);
+  const auto expect_same = [](const ObjectRegions& a, const ObjectRegions& b, const char* what) {
+    EXPECT_EQ(a.valid, b.valid) << what;
+    EXPECT_EQ(a.hull, b.hull) << what;
+    EXPECT_EQ(a.outer, b.outer) << what;
+    EXPECT_EQ(a.inner, b.inner) << what;
+    EXPECT_EQ(a.flags.any(), b.flags.any()) << what;
+    EXPECT_EQ(a.flags.behind_camera, b.flags.behind_camera) << what;
+    EXPECT_TRUE(a.assessment == b.assessment || (std::isinf(a.assessment) && std::isinf(b.assessment))) << what;
+    ASSERT_EQ(a.vertices.size(), b.vertices.size()) << what;
+    for (std::size_t i = 0; i < a.vertices.size(); ++i) {
+      EXPECT_EQ(a.vertices[i].mean_px, b.vertices[i].mean_px) << what;
+      EXPECT_EQ(a.vertices[i].covariance_px2, b.vertices[i].covariance_px2) << what;
+    }
+  };
+  ObjectRegions reused;
+  const ObjectRegionOptions o;
+  compute_object_regions(cam, box_pose(0.02, 4 * kDeg), big, o, reused);  // large, flagged
+  compute_object_regions(cam, box_pose(0.003, 1 * kDeg), box, o, reused);
+  expect_same(reused, compute_object_regions(cam, box_pose(0.003, 1 * kDeg), box, o), "box after a bigger object");
+  compute_object_regions(cam, behind, box, o, reused);
+  expect_same(reused, compute_object_regions(cam, behind, box, o), "invalid after valid");
+  compute_object_regions(cam, box_pose(0.003, 1 * kDeg), box, o, reused);
+  expect_same(reused, compute_object_regions(cam, box_pose(0.003, 1 * kDeg), box, o), "valid after invalid");
 }
 
 // Sample true poses; each projected vertex must fall in the outer region (>= 95%), and the
@@ -335,4 +389,16 @@ TEST(Assessment, MetricsAndAggregators) {
   std::vector<ProjectedVertex> bad = vs;
   bad[1].flags.sigma_point_behind_camera = true;
   EXPECT_TRUE(std::isinf(assess(default_assessment(), bad)));
+  // A metric may assess other vertices itself: the inner call must not disturb the outer.
+  const Assessment nested{[&](const ProjectedVertex& v) { return v.covariance_px2.trace() + assess(custom, vs); },
+                          [](auto, std::span<const double> x) { return x[0] + x[1]; }};
+  EXPECT_DOUBLE_EQ(assess(nested, vs), 23.0 + 2 * 23.0);
+}
+
+TEST(Assessment, SemiMajorAxisAloneEqualsTheFullAxes) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 100; ++trial) {
+    const Mat2 C = random_covariance(rng);
+    EXPECT_NEAR(ellipse_semi_major_px(C), ellipse_axes(C).major_px, 1e-12 * ellipse_axes(C).major_px);
+  }
 }

@@ -21,6 +21,8 @@ struct EllipseAxes {
   double angle_rad = 0;  // of the major axis, from +u towards +v
 };
 EllipseAxes ellipse_axes(const Mat2& covariance_px2);
+// ellipse_axes(C).major_px, cheaper (no angle).
+double ellipse_semi_major_px(const Mat2& covariance_px2);
 
 using VertexMetric = std::function<double(const ProjectedVertex&)>;
 using Aggregator =

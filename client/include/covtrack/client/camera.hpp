@@ -26,8 +26,19 @@ struct Camera {
   // J_pixel_point, if given, receives d(pixel)/d(p_camera), exact, distortion included.
   Vec2 project(const Vec3& p_camera, Mat23* J_pixel_point = nullptr) const;
 
+  // The pixel of normalised coordinates (x, y) = (X/Z, Y/Z), distortion included. Inline,
+  // so that a loop over many points (the unscented projection) vectorises.
+  void pixel_of_normalised(double x, double y, double& u, double& v) const {
+    const double r2 = x * x + y * y;
+    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    u = fx * (x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x)) + cx;
+    v = fy * (y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y) + cy;
+  }
+
   // First-order screen covariance (px^2) due to the intrinsic sigmas, at this point.
-  Mat2 intrinsic_covariance(const Vec3& p_camera) const;
+  Mat2 intrinsic_covariance(const Vec3& p_camera) const { return intrinsic_covariance_at(project(p_camera)); }
+  // The same from the point's pixel (it depends on nothing else).
+  Mat2 intrinsic_covariance_at(const Vec2& pixel) const;
 };
 
 // Reads `camera_matrix`, `distortion_coefficients` (4 or 5 values; longer vectors only if

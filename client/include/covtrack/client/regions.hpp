@@ -39,6 +39,8 @@ using Polygon = std::vector<Vec2>;
 // ---- Polygons (region_polygon.cpp) ----
 // Andrew's monotone chain; collinear points dropped. Indices into `points`.
 std::vector<int> convex_hull_indices(std::span<const Vec2> points);
+// The same into `hull` (no allocation once its capacity suffices).
+void convex_hull_indices(std::span<const Vec2> points, std::vector<int>& hull);
 Polygon convex_hull(std::span<const Vec2> points);
 // The part of a convex polygon with normal . x <= offset.
 Polygon clip_half_plane(const Polygon& convex, const Vec2& normal, double offset);
@@ -67,8 +69,13 @@ struct RegionOptions {
 
 // ---- Expansion and contraction (regions.cpp) ----
 Polygon expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& options);
+// The same into `outer` (cleared first; no allocation once its capacity suffices).
+void expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& options,
+                   Polygon& outer);
 // `hull` = the vertices of the convex hull of the means, counter-clockwise.
 Polygon contract_region(std::span<const ProjectedVertex> hull, const RegionOptions& options);
+void contract_region(std::span<const ProjectedVertex> hull, const RegionOptions& options,
+                     Polygon& inner);
 
 // ---- One object (region_object.cpp) ----
 struct ObjectRegionOptions {
@@ -94,5 +101,10 @@ struct ObjectRegions {
 ObjectRegions compute_object_regions(const Camera& camera, const UncertainPose& T_camera_object,
                                      std::span<const Vec3> vertices_object,
                                      const ObjectRegionOptions& options = {});
+// The same into `regions`: an application that keeps one per object and recomputes it
+// every frame allocates nothing once the capacities suffice.
+void compute_object_regions(const Camera& camera, const UncertainPose& T_camera_object,
+                            std::span<const Vec3> vertices_object,
+                            const ObjectRegionOptions& options, ObjectRegions& regions);
 
 }  // namespace covtrack::client
