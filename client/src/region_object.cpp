@@ -37,7 +37,7 @@ void compute_object_regions(const Camera& camera, const UncertainPose& T_camera_
   // Every vertex's ellipse goes into the outer region, not only the hull's: a vertex just
   // inside the mean hull can still stick out once perturbed. The inner region needs only
   // the hull (a subset of the true vertices spans less, so it stays conservative).
-  expand_region(r.vertices, o.regions, r.outer);
+  expand_region(r.vertices, r.hull, o.regions, r.outer);
   contract_region(hull, o.regions, r.inner);
   r.assessment = assess(o.assessment, hull);
   hull_pool = std::move(hull);

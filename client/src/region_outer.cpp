@@ -1,9 +1,11 @@
 // The outer region as the polygon of support lines of the hull of the confidence
 // ellipses, refined where it is loose (see regions.hpp for the guarantee).
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "covtrack/client/regions.hpp"
+#include "region_tangents.hpp"
 #include "vector_clones.hpp"
 
 namespace covtrack::client {
@@ -57,6 +59,42 @@ class Ellipses {
     return {n, top, farthest_point(best, n), best};
   }
 
+  // Whether every line n_j . x <= h_j holds every ellipse (to rounding). The loop runs over
+  // the lines, one ellipse at a time, so that it vectorises (a maximum over the ellipses
+  // would be a reduction, which does not).
+  bool hold_all(std::span<const double> nx, std::span<const double> ny, std::span<const double> h) {
+    const std::size_t lines = h.size();
+    excess_.assign(lines, -std::numeric_limits<double>::infinity());
+    double* excess = excess_.data();
+    for (std::size_t i = 0; i < cu_.size(); ++i) {
+      const double u = cu_[i], v = cv_[i], xx = sxx_[i], xy = sxy_[i], yy = syy_[i];
+      for (std::size_t j = 0; j < lines; ++j) {
+        const double x = nx[j], y = ny[j];
+        const double support = x * u + y * v + std::sqrt(std::max(x * x * xx + 2 * x * y * xy + y * y * yy, 0.0));
+        excess[j] = std::max(excess[j], support - h[j]);
+      }
+    }
+    for (std::size_t j = 0; j < lines; ++j)
+      if (excess[j] > 1e-9 * (1 + std::abs(h[j]))) return false;
+    return true;
+  }
+
+  // The support of ellipse i alone along unit n.
+  double support_of(std::size_t i, const Vec2& n) const {
+    return n.x() * cu_[i] + n.y() * cv_[i] +
+           std::sqrt(std::max(n.x() * n.x() * sxx_[i] + 2 * n.x() * n.y() * sxy_[i] + n.y() * n.y() * syy_[i], 0.0));
+  }
+
+  // The largest radius of curvature of ellipse i, a^2 / b (semi-axes a >= b); infinite for
+  // a segment, 0 for a point.
+  double largest_curvature_radius(std::size_t i) const {
+    const double mid = 0.5 * (sxx_[i] + syy_[i]), d = 0.5 * (sxx_[i] - syy_[i]);
+    const double half = std::sqrt(d * d + sxy_[i] * sxy_[i]);
+    const double a2 = mid + half, b2 = mid - half;
+    if (!(a2 > 0)) return 0;
+    return b2 > 0 ? a2 / std::sqrt(b2) : std::numeric_limits<double>::infinity();
+  }
+
   // The point of ellipse i farthest along n (any length): c + S n / sqrt(n^T S n).
   Vec2 farthest_point(std::size_t i, const Vec2& n) const {
     const Vec2 c(cu_[i], cv_[i]);
@@ -67,16 +105,15 @@ class Ellipses {
 
  private:
   static constexpr std::size_t kBlock = 8;
-  std::vector<double> cu_, cv_, sxx_, sxy_, syy_, h_;
+  std::vector<double> cu_, cv_, sxx_, sxy_, syy_, h_, excess_;
 };
 
 double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
-// Where two support lines (normals less than pi apart) cross.
-Vec2 corner(const SupportLine& a, const SupportLine& b) {
-  const double inverse_det = 1 / cross(a.normal, b.normal);
-  return inverse_det * Vec2(a.offset * b.normal.y() - b.offset * a.normal.y(),
-                            b.offset * a.normal.x() - a.offset * b.normal.x());
+// Where two lines n . x = h (normals less than pi apart) cross.
+Vec2 corner(const Vec2& na, double ha, const Vec2& nb, double hb) {
+  const double inverse_det = 1 / cross(na, nb);
+  return inverse_det * Vec2(ha * nb.y() - hb * na.y(), hb * na.x() - ha * nb.x());
 }
 
 // The direction to split the gap between lines a and b: the normal of the chord between
@@ -101,18 +138,121 @@ double squared_distance_to_segment(const Vec2& q, const Vec2& a, const Vec2& b) 
   return (q - (a + t * ab)).squaredNorm();
 }
 
+
+// A line of the shortcut below: normal . x <= offset.
+struct ArcLine {
+  Vec2 normal;
+  double offset;
+  std::size_t ellipse;  // of the arc that starts at this line
+};
+
+// An upper bound of the angle from unit a to unit b (counter-clockwise, less than pi),
+// without trigonometry: theta = 2 atan(x), x = cross / (1 + dot), and atan(x) is within
+// 0.005 rad of x / (1 + 0.28125 x^2) for |x| <= 1 (of pi/2 - the same at 1/x beyond).
+double angle_upper_bound(const Vec2& a, const Vec2& b) {
+  const double x = cross(a, b) / (1 + a.dot(b));
+  const double half = x <= 1 ? x / (1 + 0.28125 * x * x)
+                             : std::numbers::pi / 2 - (1 / x) / (1 + 0.28125 / (x * x));
+  return 2 * (half + 0.005);
+}
+
+// The shortcut. Usually the boundary of the ellipses' hull is an arc of each mean hull
+// vertex's ellipse, joined to the next by their common outer tangent. This builds that
+// directly: the tangents solved side by side (region_tangents.hpp); each arc's directions by
+// halving its angle until the ellipse's largest radius of curvature rho gives a corner
+// within the tolerance (the circle bound rho (1/cos(g/2) - 1) <= tol holds for
+// g/2 <= sqrt(2r / (1 + r)), r = tol / rho). Nothing is assumed: every line is checked to be a
+// support of the whole set and every corner to be within the tolerance of its ellipse's
+// point facing it, as in the search. It returns false where any check fails (an ellipse off
+// the mean hull sticking out, one swallowed by its neighbours, a sharp or degenerate arc):
+// the caller then searches.
+bool expand_by_arcs(Ellipses& ellipses, std::span<const ProjectedVertex> vertices,
+                    std::span<const int> hull, double s2, const RegionOptions& o, Polygon& outer) {
+  const std::size_t k = hull.size();
+  if (k < 3) return false;
+  constexpr int kMostHalvings = 6;  // 64 lines per arc
+  const double tol = o.max_polygon_error_px;
+
+  // The tangent of hull edge i (hull[i] -> hull[i + 1]) starts the arc of ellipse hull[i + 1].
+  thread_local std::vector<ArcLine> tangents, lines;
+  tangents.resize(k);
+  TangentBlock block;
+  for (std::size_t first = 0; first < k; first += kTangentPairs) {
+    const int count = static_cast<int>(std::min<std::size_t>(kTangentPairs, k - first));
+    for (int j = 0; j < kTangentPairs; ++j) {  // a short block repeats its first edge
+      const std::size_t i = first + (j < count ? j : 0);
+      set_tangent_pair(block, j, vertices[hull[i]], vertices[hull[(i + 1) % k]], s2);
+    }
+    common_tangents(block, TangentSide::outer);
+    for (int j = 0; j < count; ++j) {
+      if (block.solved[j] == 0) return false;
+      const std::size_t i = first + j;
+      tangents[i] = {Vec2(block.nu[j], block.nv[j]), block.offset[j],
+                     static_cast<std::size_t>(hull[(i + 1) % k])};
+    }
+  }
+
+  lines.clear();
+  for (std::size_t i = 0; i < k; ++i) {
+    const ArcLine& start = tangents[i];
+    const Vec2& end = tangents[(i + 1) % k].normal;
+    // An arc turns counter-clockwise by less than pi; otherwise its ellipse is not on the
+    // boundary as assumed.
+    if (!(cross(start.normal, end) > 1e-9) || start.normal.dot(end) < -0.99) return false;
+    const double rho = ellipses.largest_curvature_radius(start.ellipse);
+    const double r = tol / rho;
+    const double step = rho > 0 ? 2 * std::sqrt(2 * r / (1 + r)) : std::numbers::pi;
+    const double angle = angle_upper_bound(start.normal, end);
+    int halvings = 0;
+    while (angle > step * (1 << halvings))
+      if (++halvings > kMostHalvings) return false;
+    lines.push_back(start);
+    // Directions by halving: normalised sums of neighbours, uniform in angle.
+    const int n = 1 << halvings;
+    Vec2 dirs[(1 << kMostHalvings) + 1];
+    dirs[0] = start.normal, dirs[n] = end;
+    for (int gap = n; gap > 1; gap /= 2)
+      for (int j = gap / 2; j < n; j += gap) dirs[j] = (dirs[j - gap / 2] + dirs[j + gap / 2]).normalized();
+    for (int j = 1; j < n; ++j)
+      lines.push_back({dirs[j], ellipses.support_of(start.ellipse, dirs[j]), start.ellipse});
+    if (static_cast<int>(lines.size()) > o.max_outer_corners) return false;
+  }
+
+  // Every line a support of the whole set (to rounding).
+  thread_local std::vector<double> nx, ny, h;
+  nx.clear(), ny.clear(), h.clear();
+  for (const ArcLine& line : lines)
+    nx.push_back(line.normal.x()), ny.push_back(line.normal.y()), h.push_back(line.offset);
+  if (!ellipses.hold_all(nx, ny, h)) return false;
+  // Every corner within the tolerance of the arc's ellipse.
+  const double tolerance2 = tol * tol;
+  outer.clear();
+  for (std::size_t p = 0; p < lines.size(); ++p) {
+    const ArcLine& a = lines[p];
+    const ArcLine& b = lines[p + 1 == lines.size() ? 0 : p + 1];
+    const Vec2 q = corner(a.normal, a.offset, b.normal, b.offset);
+    if ((q - ellipses.farthest_point(a.ellipse, a.normal + b.normal)).squaredNorm() > tolerance2)
+      return false;
+    if (outer.empty() || (q - outer.back()).squaredNorm() > 1e-18) outer.push_back(q);
+  }
+  while (outer.size() > 1 && (outer.front() - outer.back()).squaredNorm() <= 1e-18) outer.pop_back();
+  return true;
+}
+
 }  // namespace
 
 // One clone per instruction set (vector_clones.hpp); flatten inlines the helpers, so the
 // supports' loop is compiled for the clone's instructions too.
 [[gnu::flatten]] COVTRACK_VECTOR_CLONES
-void expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& o,
-                   Polygon& outer) {
+void expand_region(std::span<const ProjectedVertex> vertices, std::span<const int> mean_hull,
+                   const RegionOptions& o, Polygon& outer) {
   outer.clear();
   if (vertices.empty()) return;
   const double s2 = std::pow(confidence_scale(o.confidence), 2);
   thread_local Ellipses ellipses;
   ellipses.assign(vertices, s2);
+  if (o.outer_by_arcs && expand_by_arcs(ellipses, vertices, mean_hull, s2, o, outer)) return;
+  outer.clear();  // the shortcut may have left corners behind
   const double tolerance2 = o.max_polygon_error_px * o.max_polygon_error_px;
 
   // Start with 8 directions; split a gap while the corner of its two lines lies farther
@@ -130,7 +270,7 @@ void expand_region(std::span<const ProjectedVertex> vertices, const RegionOption
   SupportLine current = first;
   while (!pending.empty()) {
     const SupportLine& next = pending.back();
-    const Vec2 q = corner(current, next);
+    const Vec2 q = corner(current.normal, current.offset, next.normal, next.offset);
     // The corner's distance to the hull is at most its distance to any point of the hull:
     // the chord between the contacts, and, when one ellipse touches both lines, that
     // ellipse's point facing the corner (the bisector's contact). On a circle of radius R
@@ -153,6 +293,16 @@ void expand_region(std::span<const ProjectedVertex> vertices, const RegionOption
   }
   // The last corner (between the lines at 2 pi and 0) repeats the first when they meet.
   while (outer.size() > 1 && (outer.front() - outer.back()).squaredNorm() <= 1e-18) outer.pop_back();
+}
+
+void expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& o,
+                   Polygon& outer) {
+  thread_local std::vector<Vec2> means;
+  thread_local std::vector<int> hull;
+  means.clear();
+  for (const ProjectedVertex& v : vertices) means.push_back(v.mean_px);
+  convex_hull_indices(means, hull);
+  expand_region(vertices, hull, o, outer);
 }
 
 Polygon expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& o) {

@@ -10,6 +10,9 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include <fmt/format.h>
+
+#include "bench_frame.hpp"
 #include "example_camera.hpp"
 
 #include "covtrack/client/regions.hpp"
@@ -120,40 +123,66 @@ double distance_to_polygon_boundary(const Polygon& poly, const Vec2& q) {
   return best;
 }
 
-TEST(OuterRegion, ContainsEveryEllipseAndStaysWithinTheBound) {
-  std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> u(0, 1);
-  const RegionOptions o;
+// The outer region's guarantee: dense points of every ellipse all inside it, and every
+// corner within the bound of their hull (which lies inside the true hull of the ellipses).
+void expect_outer_guarantee(std::span<const ProjectedVertex> vertices, const Polygon& outer,
+                            const RegionOptions& o, const std::string& what) {
+  ASSERT_GE(outer.size(), 3u) << what;
+  ASSERT_GT(polygon_area(outer), 0) << "counter-clockwise: " << what;
   const double scale = confidence_scale(o.confidence);
-  std::size_t corners = 0;
-  for (int trial = 0; trial < 200; ++trial) {
-    std::vector<ProjectedVertex> vertices(2 + trial % 9);
-    for (ProjectedVertex& v : vertices) {
-      v.mean_px = Vec2(400 * u(rng), 300 * u(rng));
-      const double size = std::pow(10.0, 3 * u(rng) - 1.5);  // 0.03 to 30: tiny to huge
-      v.covariance_px2 = (u(rng) < 0.1 ? 0.0 : size * size) * random_covariance(rng) / 25;
+  std::vector<Vec2> dense;
+  for (const ProjectedVertex& v : vertices) {
+    const Eigen::SelfAdjointEigenSolver<Mat2> eig(v.covariance_px2);
+    const Mat2 A = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+    for (int k = 0; k < 2000; ++k) {
+      const double t = 2 * std::numbers::pi * k / 2000;
+      dense.push_back(v.mean_px + scale * A * Vec2(std::cos(t), std::sin(t)));
+      ASSERT_TRUE(polygon_contains(outer, dense.back(), 1e-7)) << what;
     }
-    const Polygon outer = expand_region(vertices, o);
-    ASSERT_GE(outer.size(), 3u);
-    ASSERT_GT(polygon_area(outer), 0) << "counter-clockwise";
-    corners += outer.size();
-    // Dense inscribed points of every ellipse: all inside the outer region, and their hull
-    // (inside the true hull of the ellipses) within the bound of every outer corner.
-    std::vector<Vec2> dense;
-    for (const ProjectedVertex& v : vertices) {
-      const Eigen::SelfAdjointEigenSolver<Mat2> eig(v.covariance_px2);
-      const Mat2 A = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
-      for (int k = 0; k < 2000; ++k) {
-        const double t = 2 * std::numbers::pi * k / 2000;
-        dense.push_back(v.mean_px + scale * A * Vec2(std::cos(t), std::sin(t)));
-        ASSERT_TRUE(polygon_contains(outer, dense.back(), 1e-7)) << "trial " << trial;
-      }
-    }
-    const Polygon truth = convex_hull(dense);
-    for (const Vec2& q : outer)
-      EXPECT_LE(distance_to_polygon_boundary(truth, q), o.max_polygon_error_px + 0.01) << "trial " << trial;
   }
-  std::printf("outer region: %.1f corners on average\n", double(corners) / 200);
+  const Polygon truth = convex_hull(dense);
+  for (const Vec2& q : outer)
+    EXPECT_LE(distance_to_polygon_boundary(truth, q), o.max_polygon_error_px + 0.01) << what;
+}
+
+// Random ellipses from tiny to huge, the shortcut where it applies and the search alone.
+TEST(OuterRegion, ContainsEveryEllipseAndStaysWithinTheBound) {
+  for (const bool by_arcs : {true, false}) {
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(0, 1);
+    RegionOptions o;
+    o.outer_by_arcs = by_arcs;
+    std::size_t corners = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+      std::vector<ProjectedVertex> vertices(2 + trial % 9);
+      for (ProjectedVertex& v : vertices) {
+        v.mean_px = Vec2(400 * u(rng), 300 * u(rng));
+        const double size = std::pow(10.0, 3 * u(rng) - 1.5);  // 0.03 to 30: tiny to huge
+        v.covariance_px2 = (u(rng) < 0.1 ? 0.0 : size * size) * random_covariance(rng) / 25;
+      }
+      const Polygon outer = expand_region(vertices, o);
+      corners += outer.size();
+      expect_outer_guarantee(vertices, outer, o, fmt::format("trial {}, by arcs {}", trial, by_arcs));
+    }
+    std::printf("outer region (by arcs %d): %.1f corners on average\n", by_arcs, double(corners) / 200);
+  }
+}
+
+// Boxes as the benchmark frame has them: the shortcut applies to nearly all of them (its
+// corners differ from the search's) and keeps the guarantee.
+TEST(OuterRegion, ShortcutAppliesToTypicalObjectsAndKeepsTheGuarantee) {
+  const test::BenchFrame f = test::make_bench_frame(100);
+  RegionOptions search;
+  search.outer_by_arcs = false;
+  int shortcut = 0;
+  for (std::size_t i = 0; i < f.poses.size(); ++i) {
+    const std::vector<ProjectedVertex> vertices = project_vertices(f.camera, f.poses[i], f.vertices[i]);
+    const Polygon by_arcs = expand_region(vertices, RegionOptions{});
+    expect_outer_guarantee(vertices, by_arcs, RegionOptions{}, fmt::format("object {}", i));
+    shortcut += by_arcs != expand_region(vertices, search);
+  }
+  std::printf("the shortcut applied to %d of %zu objects\n", shortcut, f.poses.size());
+  EXPECT_GE(shortcut, 90);
 }
 
 // Zero covariance everywhere (sqrt(0) supports): the outer region is the hull of the

@@ -16,6 +16,10 @@
 //    facing the corner (both lie inside the hull), so every corner, hence every point of
 //    the polygon, is within that distance of the hull. This costs a few dozen support
 //    evaluations per object instead of a hull over every ellipse's polygon (region_outer.cpp).
+//    Usually a shortcut applies first: the lines are the common outer tangents of adjacent
+//    mean hull vertices' ellipses and, between them, each ellipse's own supports at
+//    directions spaced by its curvature; it is kept only when every line holds every
+//    ellipse and every corner passes the same distance test, so the guarantee is the same.
 //  - Inner region (contraction, 5.5.2): for each edge of the hull of the mean vertices, the
 //    line tangent to both adjacent ellipses on the interior side; the region is the
 //    intersection of the interior half-planes. Where the seed's construction (corners =
@@ -65,6 +69,10 @@ struct RegionOptions {
   // confidence ellipses...
   double max_polygon_error_px = 0.5;
   int max_outer_corners = 256;  // ...unless this cap is hit (enormous ellipses)
+  // Build the outer region from the mean hull's tangents and arcs where every check allows
+  // (region_outer.cpp); the general search otherwise, or always when false. Both give the
+  // guarantee above; the shortcut is about 1.4x faster on typical objects.
+  bool outer_by_arcs = true;
 };
 
 // ---- Expansion and contraction (regions.cpp) ----
@@ -72,6 +80,10 @@ Polygon expand_region(std::span<const ProjectedVertex> vertices, const RegionOpt
 // The same into `outer` (cleared first; no allocation once its capacity suffices).
 void expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& options,
                    Polygon& outer);
+// The same given the counter-clockwise hull of the means (indices into `vertices`, as
+// convex_hull_indices gives), which compute_object_regions has at hand.
+void expand_region(std::span<const ProjectedVertex> vertices, std::span<const int> mean_hull,
+                   const RegionOptions& options, Polygon& outer);
 // `hull` = the vertices of the convex hull of the means, counter-clockwise.
 Polygon contract_region(std::span<const ProjectedVertex> hull, const RegionOptions& options);
 void contract_region(std::span<const ProjectedVertex> hull, const RegionOptions& options,
