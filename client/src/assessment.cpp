@@ -7,7 +7,16 @@
 
 namespace covtrack::client {
 
-double confidence_scale(double probability) { return std::sqrt(-2.0 * std::log1p(-probability)); }
+double confidence_scale(double probability) {
+  // Every object's regions ask for the same confidence: remember the last one (a log per
+  // call was 2% of a frame).
+  thread_local double last_probability = std::numeric_limits<double>::quiet_NaN(), last_scale = 0;
+  if (probability != last_probability) {
+    last_scale = std::sqrt(-2.0 * std::log1p(-probability));
+    last_probability = probability;
+  }
+  return last_scale;
+}
 
 EllipseAxes ellipse_axes(const Mat2& C) {
   // Closed form for a symmetric 2x2: no iterative solver per vertex.

@@ -219,6 +219,7 @@ void project_unscented(const Camera& camera, const UncertainPose& pose,
                        std::span<const Vec3> points, const ProjectionOptions& o,
                        const ProjectionFlags& shared, std::vector<ProjectedVertex>& out) {
   const SigmaPoses sigma = make_sigma_poses(pose, o.unscented);
+  const bool add_intrinsic = o.add_intrinsic_uncertainty && !camera.intrinsic_sigmas_px.isZero();
   UnscentedBlock b;
   for (std::size_t first = 0; first < points.size(); first += kBlock) {
     const int count = static_cast<int>(std::min<std::size_t>(kBlock, points.size() - first));
@@ -247,7 +248,7 @@ void project_unscented(const Camera& camera, const UncertainPose& pose,
       Mat2 C;
       C << b.cuu[j], b.cuv[j], b.cuv[j], b.cvv[j];
       v.covariance_px2 = repair_psd(C, v.flags.covariance_repaired);
-      if (o.add_intrinsic_uncertainty) v.covariance_px2 += camera.intrinsic_covariance_at(unperturbed);
+      if (add_intrinsic) v.covariance_px2 += camera.intrinsic_covariance_at(unperturbed);
     }
   }
 }
