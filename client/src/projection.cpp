@@ -53,58 +53,68 @@ struct SigmaPoses {
   double wm0, wc0, wi;
 };
 
-RigidMap compose(const Mat3& R0, const Vec3& t0, const double (&E)[9], const Vec3& te) {
-  RigidMap m;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j)
-      m.r[3 * i + j] = R0(i, 0) * E[j] + R0(i, 1) * E[3 + j] + R0(i, 2) * E[6 + j];
-    m.t[i] = R0(i, 0) * te.x() + R0(i, 1) * te.y() + R0(i, 2) * te.z() + t0[i];
-  }
-  return m;
-}
-
-// T * Exp(xi) and T * Exp(-xi), as pose * se3_exp(+-xi) but with one sin/cos pair for both
-// signs and for both the rotation and the left Jacobian (se3_exp evaluates them
-// separately; this is the per-object hot path). With K = skew(phi), theta = |phi| and
-// K^2 = phi phi^T - theta^2 I:
+// The 2n sigma poses T * Exp(+-xi_i) for the columns xi_i = (rho, phi) of S, as
+// pose * se3_exp(+-xi) but all columns at once in loops that vectorise (vector_clones.hpp),
+// with one (a, b, c) per column for both signs and for both the rotation and the left
+// Jacobian. With K = skew(phi), theta = |phi| and K^2 = phi phi^T - theta^2 I:
 //   R = (1 - b theta^2) I + b phi phi^T + a K,
 //   V rho = (1 - c theta^2) rho + c phi (phi . rho) + b phi x rho,
 //   a = sin(theta)/theta, b = (1 - cos(theta))/theta^2, c = (theta - sin(theta))/theta^3.
 // Negating xi flips the a K term of R and the terms of V rho that are odd in xi.
-void compose_exp_pair(const Mat3& R0, const Vec3& t0, const Vec6& xi, RigidMap& plus,
-                      RigidMap& minus) {
-  const Vec3 rho = xi.head<3>(), phi = xi.tail<3>();
-  const double t2 = phi.squaredNorm();
-  double a, b, c;
-  if (t2 < 0.09) {
+// Writes out[1 + i] = T Exp(xi_i) and out[1 + n + i] = T Exp(-xi_i).
+COVTRACK_VECTOR_CLONES
+void exp_sigma_poses(const Mat3& R0, const Vec3& t0, const Mat6& S, std::array<RigidMap, kSigmaPoints>& out) {
+  constexpr int kLanes = 8;  // the n = 6 columns and two zero columns: whole vectors
+  double rx[kLanes] = {}, ry[kLanes] = {}, rz[kLanes] = {}, px[kLanes] = {}, py[kLanes] = {}, pz[kLanes] = {};
+  for (int i = 0; i < kN; ++i)
+    rx[i] = S(0, i), ry[i] = S(1, i), rz[i] = S(2, i), px[i] = S(3, i), py[i] = S(4, i), pz[i] = S(5, i);
+  double t2[kLanes], a[kLanes], b[kLanes], c[kLanes];
+  for (int i = 0; i < kLanes; ++i) {
     // theta < 0.3 rad (sigma points of rotation sigmas up to 10 degrees): the Taylor series
-    // to theta^10, in Horner form with constant coefficients (multiplications, no
-    // divisions). The next terms are below 1e-16: as exact as sin and cos, and no
-    // cancellation in c. Coefficients: (-1)^k / (2k+1)!, / (2k+2)!, / (2k+3)!.
-    const double t = t2;
-    a = 1 + t * (-1 / 6. + t * (1 / 120. + t * (-1 / 5040. + t * (1 / 362880. + t * (-1 / 39916800.)))));
-    b = 1 / 2. + t * (-1 / 24. + t * (1 / 720. + t * (-1 / 40320. + t * (1 / 3628800. + t * (-1 / 479001600.)))));
-    c = 1 / 6. + t * (-1 / 120. + t * (1 / 5040. + t * (-1 / 362880. + t * (1 / 39916800. + t * (-1 / 6227020800.)))));
-  } else {
-    const double theta = std::sqrt(t2), inv = 1 / theta;
-    const double sn = std::sin(theta), cs = std::cos(theta);
-    a = sn * inv;
-    b = (1 - cs) * inv * inv;
-    c = (theta - sn) * inv * inv * inv;
+    // to theta^10, in Horner form with constant coefficients (no divisions). The next terms
+    // are below 1e-16: as exact as sin and cos, and no cancellation in c. Coefficients:
+    // (-1)^k / (2k+1)!, / (2k+2)!, / (2k+3)!. Larger angles are redone below.
+    const double t = t2[i] = px[i] * px[i] + py[i] * py[i] + pz[i] * pz[i];
+    a[i] = 1 + t * (-1 / 6. + t * (1 / 120. + t * (-1 / 5040. + t * (1 / 362880. + t * (-1 / 39916800.)))));
+    b[i] = 1 / 2. + t * (-1 / 24. + t * (1 / 720. + t * (-1 / 40320. + t * (1 / 3628800. + t * (-1 / 479001600.)))));
+    c[i] = 1 / 6. + t * (-1 / 120. + t * (1 / 5040. + t * (-1 / 362880. + t * (1 / 39916800. + t * (-1 / 6227020800.)))));
   }
-  const double x = phi.x(), y = phi.y(), z = phi.z(), d = 1 - b * t2;
-  const double ax = a * x, ay = a * y, az = a * z;
-  const double bxy = b * x * y, bxz = b * x * z, byz = b * y * z;
-  const double Ep[9] = {d + b * x * x, bxy - az, bxz + ay,
-                        bxy + az, d + b * y * y, byz - ax,
-                        bxz - ay, byz + ax, d + b * z * z};
-  const double Em[9] = {Ep[0], bxy + az, bxz - ay,
-                        bxy - az, Ep[4], byz + ax,
-                        bxz + ay, byz - ax, Ep[8]};
-  const Vec3 odd = (1 - c * t2) * rho + c * phi.dot(rho) * phi;
-  const Vec3 even = b * phi.cross(rho);
-  plus = compose(R0, t0, Ep, even + odd);
-  minus = compose(R0, t0, Em, even - odd);
+  for (int i = 0; i < kN; ++i)
+    if (t2[i] >= 0.09) {
+      const double theta = std::sqrt(t2[i]), inv = 1 / theta;
+      const double sn = std::sin(theta), cs = std::cos(theta);
+      a[i] = sn * inv;
+      b[i] = (1 - cs) * inv * inv;
+      c[i] = (theta - sn) * inv * inv * inv;
+    }
+  // Rotation and translation of both signs, composed with T: row-major 3x3 then 3.
+  double plus[12][kLanes], minus[12][kLanes];
+  for (int i = 0; i < kLanes; ++i) {
+    const double x = px[i], y = py[i], z = pz[i], d = 1 - b[i] * t2[i];
+    const double ax = a[i] * x, ay = a[i] * y, az = a[i] * z;
+    const double bxy = b[i] * x * y, bxz = b[i] * x * z, byz = b[i] * y * z;
+    const double Ep[9] = {d + b[i] * x * x, bxy - az, bxz + ay,
+                          bxy + az, d + b[i] * y * y, byz - ax,
+                          bxz - ay, byz + ax, d + b[i] * z * z};
+    const double Em[9] = {Ep[0], bxy + az, bxz - ay,
+                          bxy - az, Ep[4], byz + ax,
+                          bxz + ay, byz - ax, Ep[8]};
+    const double dot = x * rx[i] + y * ry[i] + z * rz[i], lin = 1 - c[i] * t2[i];
+    const double odd[3] = {lin * rx[i] + c[i] * dot * x, lin * ry[i] + c[i] * dot * y, lin * rz[i] + c[i] * dot * z};
+    const double even[3] = {b[i] * (y * rz[i] - z * ry[i]), b[i] * (z * rx[i] - x * rz[i]), b[i] * (x * ry[i] - y * rx[i])};
+    for (int r = 0; r < 3; ++r) {
+      for (int k = 0; k < 3; ++k) {
+        plus[3 * r + k][i] = R0(r, 0) * Ep[k] + R0(r, 1) * Ep[3 + k] + R0(r, 2) * Ep[6 + k];
+        minus[3 * r + k][i] = R0(r, 0) * Em[k] + R0(r, 1) * Em[3 + k] + R0(r, 2) * Em[6 + k];
+      }
+      plus[9 + r][i] = R0(r, 0) * (even[0] + odd[0]) + R0(r, 1) * (even[1] + odd[1]) + R0(r, 2) * (even[2] + odd[2]) + t0[r];
+      minus[9 + r][i] = R0(r, 0) * (even[0] - odd[0]) + R0(r, 1) * (even[1] - odd[1]) + R0(r, 2) * (even[2] - odd[2]) + t0[r];
+    }
+  }
+  for (int i = 0; i < kN; ++i) {
+    for (int e = 0; e < 9; ++e) out[1 + i].r[e] = plus[e][i], out[1 + kN + i].r[e] = minus[e][i];
+    for (int e = 0; e < 3; ++e) out[1 + i].t[e] = plus[9 + e][i], out[1 + kN + i].t[e] = minus[9 + e][i];
+  }
 }
 
 SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut) {
@@ -123,9 +133,11 @@ SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut
   const Mat3 R = pose.T.linear();
   const Vec3 t = pose.T.translation();
   SigmaPoses s;
-  const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  s.T[0] = compose(R, t, identity, Vec3::Zero());
-  for (int i = 0; i < kN; ++i) compose_exp_pair(R, t, S.col(i), s.T[1 + i], s.T[1 + kN + i]);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) s.T[0].r[3 * i + j] = R(i, j);
+    s.T[0].t[i] = t[i];
+  }
+  exp_sigma_poses(R, t, S, s.T);
   s.wm0 = lambda / (kN + lambda);
   s.wc0 = s.wm0 + (1 - ut.alpha * ut.alpha + ut.beta);
   s.wi = 0.5 / (kN + lambda);
