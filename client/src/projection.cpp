@@ -223,10 +223,6 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
   }
 }
 
-}  // namespace
-
-namespace {
-
 void project_unscented(const Camera& camera, const UncertainPose& pose,
                        std::span<const Vec3> points, const ProjectionOptions& o,
                        const ProjectionFlags& shared, std::vector<ProjectedVertex>& out) {

@@ -1,5 +1,6 @@
 // The outer region as the polygon of support lines of the hull of the confidence
-// ellipses, refined where it is loose (see regions.hpp for the guarantee).
+// ellipses: built from the mean hull's tangents and arcs where every check passes, else
+// searched for and refined where it is loose (see regions.hpp for the guarantee).
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -138,12 +139,11 @@ double squared_distance_to_segment(const Vec2& q, const Vec2& a, const Vec2& b) 
   return (q - (a + t * ab)).squaredNorm();
 }
 
-
 // A line of the shortcut below: normal . x <= offset.
 struct ArcLine {
   Vec2 normal;
   double offset;
-  std::size_t ellipse;  // of the arc that starts at this line
+  std::size_t ellipse;  // of the arc this line starts or lies in
 };
 
 // An upper bound of the angle from unit a to unit b (counter-clockwise, less than pi),
