@@ -23,9 +23,8 @@ int main() {
                                          {7, 0.08, test::tag_pose(0.9, -30, -5, -20, 0.2, 0.05)}};
   std::mt19937_64 rng(1);
   const cv::Mat frame = add_sensor_noise(render_tags(cam, **family, tags, RenderLook{}), 3, rng);
-  // The calibrated coefficients (config defaults), narrow quiet-band term included.
-  const CornerNoiseModel model{1.38, 0.030, 0.075, 0.038, 0.052, 0.142, 6};
-  const double quiet_cells = (*family)->quiet_cells(RenderLook{}.margin_cells);
+  // The calibrated coefficients (config defaults), edge-shift correction included.
+  const CornerNoiseModel model = test::calibrated_corner_model();
   constexpr int kFrames = 40;
   for (double decimate : {1.0, 2.0}) {
     DetectorOptions o;
@@ -37,21 +36,21 @@ int main() {
       const auto t0 = Clock::now();
       const auto found = (*detector)->detect(frame);
       const auto t1 = Clock::now();
-      // The covariance's own work: noise inputs, quiet bands, Jacobian, 8x8 corner
-      // covariance and the information inverse.
+      // The covariance's own work: the model's inputs (noise, contrast, edge blur, border
+      // widths, ...), the edge-shift correction, Jacobian, 8x8 corner covariance and the
+      // information inverse.
       const double noise = estimate_image_noise(frame);
       for (const Detection& d : found) {
-        const double sigma = model.sigma_px(noise, tag_contrast(frame, d.corners_px, 8),
-                                            mean_edge_length_px(d.corners_px),
-                                            edge_axis_alignment(d.corners_px));
-        const auto band = corner_quiet_band_px(d.corners_px, 8, quiet_cells);
+        const CornerNoise n = model.noise(measure_corner_inputs(frame, d, **family, noise));
+        const auto moved = move_edges_in(d.corners_px, n.edge_shift_px);
         Eigen::Matrix<double, 8, 8> corner_cov = Eigen::Matrix<double, 8, 8>::Zero();
         for (int i = 0; i < 8; ++i) {
-          const double extra = model.narrow_sigma_px(band[static_cast<std::size_t>(i / 2)]);
-          corner_cov(i, i) = sigma * sigma + extra * extra;
+          const double extra = n.extra_px[static_cast<std::size_t>(i / 2)];
+          corner_cov(i, i) = n.sigma_px * n.sigma_px + extra * extra;
         }
         volatile double sink =
-            pose_covariance(corner_jacobian(cam, tags[0].T_camera_tag, 0.16), corner_cov)(0, 0);
+            pose_covariance(corner_jacobian(cam, tags[0].T_camera_tag, 0.16), corner_cov)(0, 0) +
+            moved[0].x;
         (void)sink;
       }
       const auto t2 = Clock::now();

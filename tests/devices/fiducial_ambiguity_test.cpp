@@ -20,8 +20,7 @@ TEST(FiducialAmbiguity, CovarianceCoversBothSolutionsOfASmallFaceOnTag) {
   o.decimate = 1;
   auto draws = draw_view(cam, o, v, 100, 77);
   ASSERT_TRUE(draws.has_value()) << draws.error().message;
-  // The coefficients fiducial_nees_test calibrates (also the config defaults).
-  const CornerNoiseModel model{1.38, 0.030, 0.075, 0.038, 0.052, 0.142, 6};
+  const CornerNoiseModel model = test::calibrated_corner_model();
   constexpr double kChi2_6_99 = 16.812;
   int detected = 0, ambiguous = 0, truth_outside = 0, truth_outside_uninflated = 0;
   double max_second_distance = 0;
@@ -50,10 +49,10 @@ TEST(FiducialAmbiguity, CovarianceCoversBothSolutionsOfASmallFaceOnTag) {
   EXPECT_GE(detected, 90);
   EXPECT_GE(ambiguous, detected / 2) << "a small face-on tag must be flagged ambiguous";
   EXPECT_LT(max_second_distance, kChi2_6_99) << "the second pose must lie inside the covariance";
-  // Measured: 15 of 100 outside (1 expected): the inflation helps (23 without it) but does
-  // not reach the 99% level here. The detector sees this small face-on tag about 0.1 px too
-  // large (a constant radial error the model's mean radial bias, 0.04 px, does not cover);
-  // see devices/fiducial/README.md, "Limits". Held at 15%, and strictly better than without.
-  EXPECT_LE(truth_outside, detected * 15 / 100) << "the truth must lie inside the 99% region";
+  // The bar: the truth inside the 99% region for at least 90% of the draws. This
+  // small tag's edges are pulled outward by the white cells inside its thin border
+  // (0.02-0.12 px, a constant of the view); the edge-shift correction removes that
+  // (devices/fiducial/README.md, "Corner noise model").
+  EXPECT_LE(truth_outside, detected * 10 / 100) << "the truth must lie inside the 99% region";
   EXPECT_LT(truth_outside, truth_outside_uninflated) << "the inflation must help";
 }

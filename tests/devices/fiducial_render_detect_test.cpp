@@ -74,3 +74,53 @@ TEST(FiducialRenderDetect, UnknownFamilyAndIdAreErrors) {
   ASSERT_TRUE(f.has_value());
   EXPECT_FALSE((*f)->cells(100000).has_value());
 }
+
+// The edge-shift inputs of the corner model (corner_noise.hpp), on rendered tags.
+TEST(FiducialRenderDetect, BorderInnerWhiteReadsTheCodeAlongEachEdge) {
+  auto f = TagFamily::open("tag36h11");
+  ASSERT_TRUE(f.has_value());
+  int ordered = 0;  // ids whose edge 1 has a white cell at one end and a black one at the other
+  for (int id = 0; id < 60; ++id) {
+    const cv::Mat cells = *(*f)->cells(id);
+    const auto white = (*f)->border_inner_white(id);
+    // Edge 1 (right, bottom to top) is lined by column 7 of the 10 x 10 cells, rows 7..2.
+    double mean = 0;
+    for (int row = 2; row <= 7; ++row) mean += (cells.at<std::uint8_t>(row, 7) > 127) / 8.0;
+    EXPECT_NEAR((white[1][0] + white[1][1]) / 2, mean, 1e-12) << "id " << id;
+    // The line's end nearer the white cells is the whiter one.
+    const double bottom = cells.at<std::uint8_t>(7, 7) > 127, top = cells.at<std::uint8_t>(2, 7) > 127;
+    if (bottom > top) {
+      EXPECT_GT(white[1][0], white[1][1]) << "id " << id;
+      ++ordered;
+    } else if (top > bottom) {
+      EXPECT_LT(white[1][0], white[1][1]) << "id " << id;
+      ++ordered;
+    }
+  }
+  EXPECT_GT(ordered, 10);
+  auto reversed = TagFamily::open("tagStandard41h12");
+  ASSERT_TRUE(reversed.has_value());
+  for (const auto& ends : (*reversed)->border_inner_white(3)) EXPECT_EQ(ends[0] + ends[1], 0.0);
+}
+
+TEST(FiducialRenderDetect, EdgeBlurGrowsWithTheRenderedBlur) {
+  const CameraModel cam = test::small_camera();
+  auto detector = TagDetector::create(DetectorOptions{.decimate = 1});
+  ASSERT_TRUE(detector.has_value());
+  const RenderedTag tag{3, 0.15, test::tag_pose(0.8, 20, 10, 5)};
+  std::mt19937_64 rng(3);
+  double previous = 0;
+  for (double blur : {0.5, 0.8, 1.1, 1.5}) {
+    RenderLook look;
+    look.blur_sigma_px = blur;
+    const cv::Mat frame = add_sensor_noise(render_tags(cam, (*detector)->family(), {tag}, look), 2, rng);
+    const auto found = (*detector)->detect(frame);
+    ASSERT_EQ(found.size(), 1u) << "blur " << blur;
+    const double measured =
+        edge_blur_px(frame, found[0].corners_px, tag_contrast(frame, found[0].corners_px, 8));
+    // The pixel's area and the interpolation add about 0.4 px in quadrature.
+    EXPECT_NEAR(measured, std::hypot(blur, 0.4), 0.15) << "blur " << blur;
+    EXPECT_GT(measured, previous) << "blur " << blur;
+    previous = measured;
+  }
+}

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "covtrack/devices/fiducial/camera_model.hpp"
+#include "covtrack/devices/fiducial/corner_noise.hpp"
 #include "covtrack/protocol/se3.hpp"
 
 namespace covtrack::test {
@@ -28,6 +29,16 @@ inline Pose tag_pose(double distance_m, double yaw_deg, double pitch_deg, double
                 Eigen::AngleAxisd(pitch_deg * k, Vec3::UnitX())).toRotationMatrix();
   T.translation() = Vec3(x_m, y_m, distance_m);
   return T;
+}
+
+// The coefficients fiducial_nees_test calibrates (also the config defaults,
+// devices/fiducial/src/fiducial_config.cpp).
+inline fiducial::CornerNoiseModel calibrated_corner_model() {
+  fiducial::CornerNoiseModel m;
+  m.gain_px = 1.110, m.floor_px = 0.0295, m.aligned_px = 0.0864;
+  m.radial_bias_px = 0.0056, m.radial_sigma_px = 0.0330;
+  m.shift_px = 1.631, m.shift_falloff = 0.16, m.shift_sigma_px = 0.0952;
+  return m;
 }
 
 }  // namespace covtrack::test

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include <opencv2/imgproc.hpp>
 
@@ -14,24 +15,52 @@ double CornerNoiseModel::noise_term(double image_noise, double contrast, double 
   return ratio * ratio * 16.0 / std::max(16.0, edge_length_px / 8.0);
 }
 
-double CornerNoiseModel::sigma_px(double image_noise, double contrast, double edge_length_px,
-                                  double axis_alignment) const {
+std::array<double, 4> CornerNoiseModel::edge_reach(const CornerInputs& in) const {
+  std::array<double, 4> reach{};
+  // An unmeasured blur (no slope found) counts as wide: never less variance.
+  const double blur = std::isfinite(in.blur_px) && in.blur_px > 0 ? in.blur_px : 1e9;
+  for (std::size_t e = 0; e < 4; ++e) {
+    const double x = std::isfinite(in.border_px[e]) ? in.border_px[e] / blur : 0;
+    reach[e] = std::exp(-shift_falloff * x * x);
+  }
+  return reach;
+}
+
+EdgeShifts CornerNoiseModel::edge_shift_px(const CornerInputs& in) const {
+  const auto reach = edge_reach(in);
+  EdgeShifts shift{};
+  for (std::size_t e = 0; e < 4; ++e)
+    for (std::size_t end = 0; end < 2; ++end) shift[e][end] = shift_px * reach[e] * in.inner_white[e][end];
+  return shift;
+}
+
+double CornerNoiseModel::sigma_px(const CornerInputs& in) const {
   return std::sqrt(floor_px * floor_px +
-                   gain_px * gain_px * noise_term(image_noise, contrast, edge_length_px) +
-                   aligned_px * aligned_px * axis_alignment);
+                   gain_px * gain_px * noise_term(in.image_noise, in.contrast, in.edge_length_px) +
+                   aligned_px * aligned_px * in.axis_alignment);
 }
 
-double CornerNoiseModel::narrow_sigma_px(double quiet_band_px) const {
-  if (narrow_px <= 0) return 0;
-  // A degenerate quad (NaN band) counts as the narrowest band: never less variance.
-  const double band = quiet_band_px > 0.5 ? quiet_band_px : 0.5;
-  return narrow_px * std::pow(kNarrowBandPx / band, narrow_power / 2);
+CornerNoise CornerNoiseModel::noise(const CornerInputs& in) const {
+  CornerNoise out{sigma_px(in), radial_bias_px, radial_sigma_px, {}, edge_shift_px(in)};
+  const auto reach = edge_reach(in);
+  // Corner k joins edges k - 1 and k.
+  for (std::size_t k = 0; k < 4; ++k)
+    out.extra_px[k] = shift_sigma_px * std::hypot(reach[(k + 3) % 4], reach[k]);
+  return out;
 }
 
-std::array<double, 4> CornerNoiseModel::narrow_sigmas_px(const std::array<double, 4>& corner_band_px) const {
-  std::array<double, 4> sigmas{};
-  for (std::size_t k = 0; k < 4; ++k) sigmas[k] = narrow_sigma_px(corner_band_px[k]);
-  return sigmas;
+CornerInputs measure_corner_inputs(const cv::Mat& gray, const Detection& d, const TagFamily& family,
+                                   double image_noise) {
+  CornerInputs in;
+  const int cells = family.cells_across_border();
+  in.image_noise = image_noise;
+  in.contrast = tag_contrast(gray, d.corners_px, cells);
+  in.edge_length_px = mean_edge_length_px(d.corners_px);
+  in.axis_alignment = edge_axis_alignment(d.corners_px);
+  in.blur_px = edge_blur_px(gray, d.corners_px, in.contrast);
+  in.border_px = border_width_px(d.corners_px, cells);
+  in.inner_white = family.border_inner_white(d.id);
+  return in;
 }
 
 double estimate_image_noise(const cv::Mat& gray) {
@@ -100,6 +129,38 @@ double tag_contrast(const cv::Mat& gray, const std::array<cv::Point2d, 4>& c,
   return n ? sum / n : 0;
 }
 
+double edge_blur_px(const cv::Mat& gray, const std::array<cv::Point2d, 4>& c, double contrast) {
+  // Profiles across the four edges (away from the corners) averaged on a 0.25 px grid
+  // along the outward normal, so that noise averages down before the slope is taken.
+  constexpr int kHalf = 6;  // +-1.5 px: inside the black border and the quiet band
+  constexpr double kStep = 0.25;
+  std::array<double, 2 * kHalf + 1> profile{};
+  std::array<int, 2 * kHalf + 1> count{};
+  const cv::Point2d centre = (c[0] + c[1] + c[2] + c[3]) / 4.0;
+  for (int e = 0; e < 4; ++e) {
+    const cv::Point2d a = c[e], b = c[(e + 1) % 4];
+    const double length = std::hypot(b.x - a.x, b.y - a.y);
+    if (length <= 0) continue;
+    cv::Point2d n((b - a).y / length, -(b - a).x / length);
+    if (n.dot(a - centre) < 0) n = -n;
+    for (double f = 0.2; f < 0.81; f += 0.1)
+      for (int i = -kHalf; i <= kHalf; ++i) {
+        const double g = sample(gray, a + f * (b - a) + n * (i * kStep));
+        if (std::isnan(g)) continue;
+        profile[static_cast<std::size_t>(i + kHalf)] += g;
+        ++count[static_cast<std::size_t>(i + kHalf)];
+      }
+  }
+  double slope = 0;
+  for (std::size_t i = 1; i + 1 < profile.size(); ++i) {
+    if (!count[i - 1] || !count[i + 1]) continue;
+    slope = std::max(slope, (profile[i + 1] / count[i + 1] - profile[i - 1] / count[i - 1]) / (2 * kStep));
+  }
+  // A step of height C blurred by a Gaussian of sigma s has a peak slope C / (s sqrt(2 pi)).
+  if (slope <= 0) return std::numeric_limits<double>::infinity();
+  return contrast / (slope * std::sqrt(2 * M_PI));
+}
+
 double edge_axis_alignment(const std::array<cv::Point2d, 4>& c) {
   constexpr double kWidthRad = 3.0 * M_PI / 180;
   double sum = 0;
@@ -119,31 +180,22 @@ double mean_edge_length_px(const std::array<cv::Point2d, 4>& c) {
   return sum / 4;
 }
 
-std::array<double, 4> quiet_band_px(const std::array<cv::Point2d, 4>& c, int cells_across_border,
-                                    double quiet_cells) {
+std::array<double, 4> border_width_px(const std::array<cv::Point2d, 4>& c, int cells_across_border) {
   // The detected square as [-1, 1]^2 in AprilTag's corner order; a cell is 2 / cells wide.
   const cv::Point2f plane[4] = {{-1, 1}, {1, 1}, {1, -1}, {-1, -1}};
   const cv::Point2f image[4] = {c[0], c[1], c[2], c[3]};
   const cv::Matx33d H(cv::getPerspectiveTransform(plane, image));
-  const double out = 1 + 2 * quiet_cells / std::max(cells_across_border, 1);
-  std::array<double, 4> band{};
+  const double in = 1 - 2.0 / std::max(cells_across_border, 1);
+  std::array<double, 4> width{};
   for (int e = 0; e < 4; ++e) {
     const cv::Point2d a = c[e], b = c[(e + 1) % 4];
-    const cv::Vec3d m = H * cv::Vec3d(out * (plane[e].x + plane[(e + 1) % 4].x) / 2,
-                                      out * (plane[e].y + plane[(e + 1) % 4].y) / 2, 1);
+    const cv::Vec3d m = H * cv::Vec3d(in * (plane[e].x + plane[(e + 1) % 4].x) / 2,
+                                      in * (plane[e].y + plane[(e + 1) % 4].y) / 2, 1);
     const cv::Point2d p(m[0] / m[2], m[1] / m[2]);
     const double length = std::max(std::hypot(b.x - a.x, b.y - a.y), 1e-9);
-    band[static_cast<std::size_t>(e)] = std::abs((b - a).cross(p - a)) / length;
+    width[static_cast<std::size_t>(e)] = std::abs((b - a).cross(p - a)) / length;
   }
-  return band;
-}
-
-std::array<double, 4> corner_quiet_band_px(const std::array<cv::Point2d, 4>& c,
-                                           int cells_across_border, double quiet_cells) {
-  const auto edge = quiet_band_px(c, cells_across_border, quiet_cells);
-  std::array<double, 4> corner{};
-  for (std::size_t k = 0; k < 4; ++k) corner[k] = std::min(edge[(k + 3) % 4], edge[k]);
-  return corner;
+  return width;
 }
 
 }  // namespace covtrack::fiducial

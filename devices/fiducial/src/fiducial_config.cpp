@@ -21,20 +21,20 @@ const TableSpec& fiducial_device_spec() {
         {"quad_sigma", ValueType::Float, "px", "0", "blur before the quad search (0.8 speeds up "
          "noisy frames)", 0, 10},
         {"threads", ValueType::Integer, "", "1", "detector threads", 1, 64},
-        {"corner_gain_px", ValueType::Float, "px", "1.38", "corner noise model: noise/contrast gain "
+        {"corner_gain_px", ValueType::Float, "px", "1.110", "corner noise model: noise/contrast gain "
          "(devices/fiducial/README.md)", 0, 100},
-        {"corner_floor_px", ValueType::Float, "px", "0.030", "corner noise model: per-camera floor", 0, 100},
-        {"corner_aligned_px", ValueType::Float, "px", "0.075", "corner noise model: edges along "
+        {"corner_floor_px", ValueType::Float, "px", "0.0295", "corner noise model: per-camera floor", 0, 100},
+        {"corner_aligned_px", ValueType::Float, "px", "0.0864", "corner noise model: edges along "
          "pixel axes", 0, 100},
-        {"corner_narrow_px", ValueType::Float, "px", "0.142", "corner noise model: extra error of "
-         "a corner whose quiet band (white margin beyond the border) is 4 px wide", 0, 100},
-        {"corner_narrow_power", ValueType::Float, "", "6", "corner noise model: that error's "
-         "variance grows as (4 px / band)^power", 0, 20},
-        {"paper_margin_cells", ValueType::Float, "cells", "1", "white paper around the printed tag "
-         "beyond the family's own white ring, in tag cells (the renderer's margin_cells)", 0, 1000},
-        {"corner_radial_bias_px", ValueType::Float, "px", "0.038", "corner noise model: mean "
+        {"corner_shift_px", ValueType::Float, "px", "1.631", "corner noise model: outward shift of "
+         "an edge lined inside by white cells, at zero border width (corrected)", 0, 100},
+        {"corner_shift_falloff", ValueType::Float, "", "0.16", "corner noise model: that shift "
+         "fades as exp(-falloff (border / blur)^2)", 0, 100},
+        {"corner_shift_sigma_px", ValueType::Float, "px", "0.0952", "corner noise model: what the "
+         "shift correction misses, at full reach", 0, 100},
+        {"corner_radial_bias_px", ValueType::Float, "px", "0.0056", "corner noise model: mean "
          "outward error common to the four corners (removed)", -10, 10},
-        {"corner_radial_sigma_px", ValueType::Float, "px", "0.052", "corner noise model: spread of "
+        {"corner_radial_sigma_px", ValueType::Float, "px", "0.0330", "corner noise model: spread of "
          "that common error", 0, 100},
         {"ambiguity_chi2", ValueType::Float, "", "16", "inflate the covariance to cover the second "
          "pose when it fits within this many corner variances", 0, 1e6},
@@ -97,14 +97,14 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
   c.detector.decimate = r.number("decimate", 2);
   c.detector.quad_sigma = r.number("quad_sigma", 0);
   c.detector.threads = static_cast<int>(r.integer("threads", 1));
-  c.noise.gain_px = r.number("corner_gain_px", 1.38);
-  c.noise.floor_px = r.number("corner_floor_px", 0.030);
-  c.noise.aligned_px = r.number("corner_aligned_px", 0.075);
-  c.noise.narrow_px = r.number("corner_narrow_px", 0.142);
-  c.noise.narrow_power = r.number("corner_narrow_power", 6);
-  c.paper_margin_cells = r.number("paper_margin_cells", 1);
-  c.noise.radial_bias_px = r.number("corner_radial_bias_px", 0.038);
-  c.noise.radial_sigma_px = r.number("corner_radial_sigma_px", 0.052);
+  c.noise.gain_px = r.number("corner_gain_px", 1.110);
+  c.noise.floor_px = r.number("corner_floor_px", 0.0295);
+  c.noise.aligned_px = r.number("corner_aligned_px", 0.0864);
+  c.noise.shift_px = r.number("corner_shift_px", 1.631);
+  c.noise.shift_falloff = r.number("corner_shift_falloff", 0.16);
+  c.noise.shift_sigma_px = r.number("corner_shift_sigma_px", 0.0952);
+  c.noise.radial_bias_px = r.number("corner_radial_bias_px", 0.0056);
+  c.noise.radial_sigma_px = r.number("corner_radial_sigma_px", 0.0330);
   if (c.noise.floor_px <= 0 && c.noise.gain_px <= 0)
     r.error("corner_floor_px", "the corner noise model needs a floor or a gain above zero");
   c.ambiguity_chi2 = r.number("ambiguity_chi2", 16);

@@ -57,7 +57,6 @@ class FiducialDriver final : public Driver {
     auto detector = TagDetector::create(config_.detector);
     if (!detector) return std::unexpected(detector.error());
     detector_ = std::move(*detector);
-    quiet_cells_ = detector_->family().quiet_cells(config_.paper_margin_cells);
     if (auto opened = open_source(); !opened) return opened;
 
     using namespace std::chrono;
@@ -106,20 +105,15 @@ class FiducialDriver final : public Driver {
     for (const Detection& det : detector_->detect(gray)) {
       const auto size = config_.tag_size_m.find(det.id);
       if (size == config_.tag_size_m.end() || seen.count(det.id)) continue;
-      const int cells = detector_->family().cells_across_border();
-      const double contrast = tag_contrast(gray, det.corners_px, cells);
-      const double sigma = config_.noise.sigma_px(raw.image_noise, contrast,
-                                                  mean_edge_length_px(det.corners_px),
-                                                  edge_axis_alignment(det.corners_px));
-      const CornerNoise noise{sigma, config_.noise.radial_bias_px, config_.noise.radial_sigma_px,
-                              config_.noise.narrow_sigmas_px(corner_quiet_band_px(det.corners_px, cells, quiet_cells_))};
+      const CornerInputs inputs = measure_corner_inputs(gray, det, detector_->family(), raw.image_noise);
+      const CornerNoise noise = config_.noise.noise(inputs);
       auto pose = estimate_tag_pose(camera_, det.corners_px, size->second, noise, config_.ambiguity_chi2);
       if (!pose) {
         sink.count_error(fmt::format("tag {}: {}", det.id, pose.error().message));
         continue;
       }
       seen.insert(det.id);
-      RawTag rt{det, contrast, {pose->best}};
+      RawTag rt{det, inputs.contrast, {pose->best}};
       if (pose->second) rt.solutions.push_back(*pose->second);
       raw.tags.push_back(rt);
 
@@ -167,7 +161,6 @@ class FiducialDriver final : public Driver {
   std::unique_ptr<cv::VideoCapture> capture_;
   bool is_camera_ = false;
   std::uint64_t frames_published_ = 0;  // frames considered for publish_images (every n-th goes)
-  double quiet_cells_ = 2;  // uniform cells beyond the detected square's edges
   std::map<int, Pose> last_pose_;
 };
 

@@ -29,28 +29,23 @@ ViewDraw one_draw(const CameraModel& camera, TagDetector& detector, const Calibr
   for (const Detection& det : detector.detect(frame))
     if (det.id == tag.id) d.detection = det;
   if (!d.detection) return d;
-  d.image_noise = estimate_image_noise(frame);
-  d.contrast = tag_contrast(frame, d.detection->corners_px, detector.family().cells_across_border());
-  d.edge_length_px = mean_edge_length_px(d.detection->corners_px);
-  d.axis_alignment = edge_axis_alignment(d.detection->corners_px);
+  d.inputs = measure_corner_inputs(frame, *d.detection, detector.family(), estimate_image_noise(frame));
   const auto truth = projected_corners(camera, tag);
-  const auto& c = d.detection->corners_px;
-  const cv::Point2d centre = (c[0] + c[1] + c[2] + c[3]) / 4.0;
-  std::array<cv::Point2d, 4> radial, error;
-  for (int k = 0; k < 4; ++k) {
-    radial[k] = c[k] - centre;
-    radial[k] /= std::max(std::hypot(radial[k].x, radial[k].y), 1e-9);
-    error[k] = c[k] - truth[k];
-    d.radial_error_px += error[k].dot(radial[k]) / 4;
-  }
-  for (int k = 0; k < 4; ++k) {
-    const cv::Point2d e = error[k] - d.radial_error_px * radial[k];
-    d.corner_sq_errors_px2[static_cast<std::size_t>(k)] = e.dot(e);
-    d.corner_sq_error_px2 += e.dot(e) / 8;
-  }
-  d.corner_band_px = corner_quiet_band_px(c, detector.family().cells_across_border(),
-                                          detector.family().quiet_cells(view.look.margin_cells));
+  for (std::size_t k = 0; k < 4; ++k) d.truth_px[k] = truth[k];
   return d;
+}
+
+// Unit outward normals of the quad's edges (edge k from corner k to k + 1).
+std::array<cv::Point2d, 4> outward_normals(const std::array<cv::Point2d, 4>& c) {
+  const cv::Point2d centre = (c[0] + c[1] + c[2] + c[3]) / 4.0;
+  std::array<cv::Point2d, 4> normal;
+  for (std::size_t e = 0; e < 4; ++e) {
+    const cv::Point2d d = c[(e + 1) % 4] - c[e];
+    cv::Point2d n(d.y, -d.x);
+    n /= std::max(std::hypot(n.x, n.y), 1e-12);
+    normal[e] = n.dot(c[e] - centre) < 0 ? -n : n;
+  }
+  return normal;
 }
 
 }  // namespace
@@ -79,8 +74,26 @@ Result<std::vector<ViewDraw>> draw_view(const CameraModel& camera, const Detecto
 }
 
 CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& d) {
-  return {model.sigma_px(d.image_noise, d.contrast, d.edge_length_px, d.axis_alignment),
-          model.radial_bias_px, model.radial_sigma_px, model.narrow_sigmas_px(d.corner_band_px)};
+  return model.noise(d.inputs);
+}
+
+CornerErrors corner_errors(const CornerNoiseModel& model, const ViewDraw& d) {
+  CornerErrors out;
+  if (!d.detection) return out;
+  const auto c = move_edges_in(d.detection->corners_px, model.edge_shift_px(d.inputs));
+  const cv::Point2d centre = (c[0] + c[1] + c[2] + c[3]) / 4.0;
+  std::array<cv::Point2d, 4> radial;
+  for (std::size_t k = 0; k < 4; ++k) {
+    radial[k] = c[k] - centre;
+    radial[k] /= std::max(std::hypot(radial[k].x, radial[k].y), 1e-9);
+    out.error_px[k] = c[k] - d.truth_px[k];
+    out.radial_px += out.error_px[k].dot(radial[k]) / 4;
+  }
+  for (std::size_t k = 0; k < 4; ++k) {
+    const cv::Point2d e = out.error_px[k] - out.radial_px * radial[k];
+    out.sq_px2[k] = e.dot(e);
+  }
+  return out;
 }
 
 double mean_pose_nees(const CameraModel& camera, const CalibrationView& view,
@@ -104,33 +117,45 @@ namespace {
 
 using Vec4 = Eigen::Vector4d;
 
-// The narrow-band term's exponents tried (variance ~ band^-power).
-constexpr double kNarrowPowers[] = {2, 4, 6, 8, 10, 12};
+// One corner of one draw, ready for the fit: its four variance terms (sigma^2 = c . terms)
+// and its squared error (radial part removed).
+struct CornerSample {
+  Vec4 terms;
+  double sq_px2;
+};
 
-// The model's four variance terms for one corner of one draw: sigma^2 = c . terms.
-Vec4 terms_of(const CornerNoiseModel& shape, const ViewDraw& d, std::size_t corner) {
-  const double narrow = CornerNoiseModel{0, 0, 0, 0, 0, 1, shape.narrow_power}.narrow_sigma_px(
-      d.corner_band_px[corner]);
-  return {1, CornerNoiseModel::noise_term(d.image_noise, d.contrast, d.edge_length_px),
-          d.axis_alignment, narrow * narrow};
+std::vector<std::vector<CornerSample>> corner_samples(const CornerNoiseModel& model,
+                                                      const std::vector<std::vector<ViewDraw>>& views) {
+  std::vector<std::vector<CornerSample>> out;
+  for (const auto& draws : views) {
+    auto& samples = out.emplace_back();
+    for (const ViewDraw& d : draws) {
+      if (!d.detection) continue;
+      const CornerErrors err = corner_errors(model, d);
+      const auto reach = model.edge_reach(d.inputs);
+      const double noise = CornerNoiseModel::noise_term(d.inputs.image_noise, d.inputs.contrast,
+                                                        d.inputs.edge_length_px);
+      for (std::size_t k = 0; k < 4; ++k) {
+        const std::size_t a = (k + 3) % 4;  // corner k joins edges k - 1 and k
+        const double r = reach[a] * reach[a] + reach[k] * reach[k];
+        samples.push_back({Vec4(1, noise, d.inputs.axis_alignment, r), err.sq_px2[k]});
+      }
+    }
+  }
+  return out;
 }
 
 // A starting point: least squares of each view's mean squared corner error on the mean
 // terms, relative residuals; a negative coefficient is dropped.
-Vec4 initial_terms(const CornerNoiseModel& shape, const std::vector<std::vector<ViewDraw>>& views) {
+Vec4 initial_terms(const std::vector<std::vector<CornerSample>>& views) {
   std::vector<Vec4> xs;
   std::vector<double> ys;
-  for (const auto& draws : views) {
+  for (const auto& samples : views) {
+    if (samples.empty()) continue;
     Vec4 x = Vec4::Zero();
     double y = 0;
-    int n = 0;
-    for (const ViewDraw& d : draws) {
-      if (!d.detection) continue;
-      for (std::size_t k = 0; k < 4; ++k) x += terms_of(shape, d, k) / 4;
-      y += d.corner_sq_error_px2;
-      ++n;
-    }
-    if (n) xs.push_back(x / n), ys.push_back(y / n);
+    for (const CornerSample& s : samples) x += s.terms, y += s.sq_px2 / 2;
+    xs.push_back(x / samples.size()), ys.push_back(y / samples.size());
   }
   std::array<bool, 4> used{true, true, true, true};
   Vec4 c = Vec4::Zero();
@@ -160,21 +185,47 @@ Vec4 initial_terms(const CornerNoiseModel& shape, const std::vector<std::vector<
 // Sum over views of log(view's corner NEES per coordinate)^2: a view 2x over-confident
 // costs what a view 2x under-confident costs, and a few badly fitting views cannot pull
 // every other one off as a pooled mean would.
-double log_ratio_cost(const CornerNoiseModel& shape, const std::vector<std::vector<ViewDraw>>& views,
-                      const Vec4& c) {
+double log_ratio_cost(const std::vector<std::vector<CornerSample>>& views, const Vec4& c) {
   double cost = 0;
-  for (const auto& draws : views) {
+  for (const auto& samples : views) {
     double sum = 0;
-    int n = 0;
-    for (const ViewDraw& d : draws) {
-      if (!d.detection) continue;
-      for (std::size_t k = 0; k < 4; ++k)
-        sum += d.corner_sq_errors_px2[k] / 2 / std::max(c.dot(terms_of(shape, d, k)), 1e-12);
-      n += 4;
-    }
-    if (n && sum > 0) cost += std::pow(std::log(sum / n), 2);
+    for (const CornerSample& s : samples) sum += s.sq_px2 / 2 / std::max(c.dot(s.terms), 1e-12);
+    if (!samples.empty() && sum > 0) cost += std::pow(std::log(sum / samples.size()), 2);
   }
   return cost;
+}
+
+// Stage 0: each edge end's outward error against white * reach, over falloffs on a grid;
+// the amplitude by least squares through zero (no white cell inside, no shift).
+void fit_edge_shift(CornerNoiseModel& m, const std::vector<std::vector<ViewDraw>>& views) {
+  struct EdgeSample { double x2, white, shift; };
+  std::vector<EdgeSample> edges;
+  for (const auto& draws : views)
+    for (const ViewDraw& d : draws) {
+      if (!d.detection) continue;
+      const auto& c = d.detection->corners_px;
+      const auto normal = outward_normals(c);
+      for (std::size_t e = 0; e < 4; ++e) {
+        const double x = d.inputs.border_px[e] / d.inputs.blur_px;
+        if (!std::isfinite(x)) continue;
+        for (std::size_t end = 0; end < 2; ++end) {
+          const std::size_t k = (e + end) % 4;  // the edge's start or end corner
+          edges.push_back({x * x, d.inputs.inner_white[e][end], (c[k] - d.truth_px[k]).dot(normal[e])});
+        }
+      }
+    }
+  double best = std::numeric_limits<double>::infinity();
+  for (double falloff = 0.02; falloff < 2; falloff += 0.01) {
+    double gg = 0, gs = 0, ss = 0;
+    for (const EdgeSample& s : edges) {
+      const double g = s.white * std::exp(-falloff * s.x2);
+      gg += g * g, gs += g * s.shift, ss += s.shift * s.shift;
+    }
+    if (gg <= 0) continue;
+    const double amplitude = std::max(0.0, gs / gg);
+    const double residual = ss - 2 * amplitude * gs + amplitude * amplitude * gg;
+    if (residual < best) best = residual, m.shift_px = amplitude, m.shift_falloff = falloff;
+  }
 }
 
 // Coordinate search on each coefficient's logarithm, steps halving from a factor of 4;
@@ -198,51 +249,44 @@ double log_search(Vec& c, const Cost& cost_of, double tiny) {
   return best;
 }
 
-// The four corner terms fitted in log ratio from the least-squares start.
-Vec4 fit_terms(const CornerNoiseModel& shape, const std::vector<std::vector<ViewDraw>>& views,
-               double* cost_out) {
-  Vec4 c = initial_terms(shape, views);
-  *cost_out = log_search(c, [&](const Vec4& t) { return log_ratio_cost(shape, views, t); }, 1e-8);
-  return c;
-}
-
 }  // namespace
 
 CornerNoiseModel fit_corner_noise(const CameraModel& camera, const std::vector<CalibrationView>& views,
                                   const std::vector<std::vector<ViewDraw>>& draws) {
   CornerNoiseModel m;
-  Vec4 c = Vec4::Zero();
-  double best = std::numeric_limits<double>::infinity();
-  for (double power : kNarrowPowers) {
-    CornerNoiseModel shape;
-    shape.narrow_power = power;
-    double cost = 0;
-    const Vec4 trial = fit_terms(shape, draws, &cost);
-    if (cost < best) best = cost, c = trial, m.narrow_power = power;
-  }
-  m.floor_px = std::sqrt(c[0]), m.gain_px = std::sqrt(c[1]), m.aligned_px = std::sqrt(c[2]);
-  m.narrow_px = std::sqrt(c[3]);
+  fit_edge_shift(m, draws);
   double sum = 0, sq = 0;
   int n = 0;
   for (const auto& view : draws)
     for (const ViewDraw& d : view)
-      if (d.detection) sum += d.radial_error_px, sq += d.radial_error_px * d.radial_error_px, ++n;
+      if (d.detection) {
+        const double r = corner_errors(m, d).radial_px;
+        sum += r, sq += r * r, ++n;
+      }
   if (n > 1) {
     m.radial_bias_px = sum / n;
     m.radial_sigma_px = std::sqrt(std::max(0.0, sq / n - m.radial_bias_px * m.radial_bias_px));
   }
+  const auto samples = corner_samples(m, draws);
+  Vec4 c = initial_terms(samples);
+  log_search(c, [&](const Vec4& t) { return log_ratio_cost(samples, t); }, 1e-8);
+  m.floor_px = std::sqrt(c[0]), m.gain_px = std::sqrt(c[1]), m.aligned_px = std::sqrt(c[2]);
+  m.shift_sigma_px = std::sqrt(c[3]);
+  // Stage 3 on the views' geometric mean NEES, as stage 2 weighs views in log ratio: the
+  // pooled mean would be set by the few most over-confident views (face-on, edges along
+  // the pixel axes) and leave every other view under-confident.
   for (int round = 0; round < 3; ++round) {
-    double sum = 0;
-    int total = 0;
+    double log_sum = 0;
+    int views_used = 0;
     for (std::size_t v = 0; v < views.size() && v < draws.size(); ++v) {
       int n = 0;
       const double mean = mean_pose_nees(camera, views[v], draws[v], m, &n);
-      sum += mean * n, total += n;
+      if (n > 0 && mean > 0) log_sum += std::log(mean / 6.0), ++views_used;
     }
-    if (total == 0 || sum <= 0) break;
+    if (views_used == 0) break;
     // NEES scales as 1 / sigma^2.
-    const double f = std::sqrt(sum / total / 6.0);
-    m.floor_px *= f, m.gain_px *= f, m.aligned_px *= f, m.radial_sigma_px *= f, m.narrow_px *= f;
+    const double f = std::exp(log_sum / views_used / 2);
+    m.floor_px *= f, m.gain_px *= f, m.aligned_px *= f, m.radial_sigma_px *= f, m.shift_sigma_px *= f;
   }
   return m;
 }

@@ -64,9 +64,31 @@ TagFamily::~TagFamily() { destroy_(family_); }
 int TagFamily::code_count() const { return static_cast<int>(family_->ncodes); }
 int TagFamily::cells_across_border() const { return family_->width_at_border; }
 int TagFamily::cells_across_total() const { return family_->total_width; }
-double TagFamily::quiet_cells(double paper_margin_cells) const {
-  if (family_->reversed_border) return 1;
-  return (family_->total_width - family_->width_at_border) / 2 + paper_margin_cells;
+std::array<std::array<double, 2>, 4> TagFamily::border_inner_white(int id) const {
+  std::array<std::array<double, 2>, 4> white{};
+  auto m = cells(id);
+  const int n = family_->width_at_border;  // cells along an edge, corner cells included
+  if (!m || family_->reversed_border || n < 4) return white;
+  // Row 0 is the top as printed; the tag frame's y points down, so AprilTag's corner 0
+  // (-s/2, +s/2) is bottom left and its edges run bottom (left to right), right (bottom
+  // to top), top (right to left), left (top to bottom).
+  const int first = (family_->total_width - n) / 2 + 1, last = first + n - 3;
+  for (int e = 0; e < 4; ++e) {
+    // Least-squares line w(t) = mean + slope (t - 1/2) over t in [0, 1] along the edge.
+    double mean = 0, moment = 0;
+    for (int j = 1; j + 1 < n; ++j) {
+      const int i = j - 1;  // the j-th cell from the edge's start, counted inside the border
+      const int row = e == 0 ? last : e == 1 ? last - i : e == 2 ? first : first + i;
+      const int col = e == 0 ? first + i : e == 1 ? last : e == 2 ? last - i : first;
+      if (m->at<std::uint8_t>(row, col) <= 127) continue;
+      const double t0 = static_cast<double>(j) / n, t1 = static_cast<double>(j + 1) / n;
+      mean += t1 - t0;
+      moment += (t1 * t1 - t0 * t0) / 2 - (t1 - t0) / 2;
+    }
+    const double slope = 12 * moment;
+    white[static_cast<std::size_t>(e)] = {mean - slope / 2, mean + slope / 2};
+  }
+  return white;
 }
 
 Result<cv::Mat> TagFamily::cells(int id) const {

@@ -42,6 +42,30 @@ double sse(const CameraModel& cam, const Pose& T, const std::array<Vec3, 4>& obj
 
 }  // namespace
 
+std::array<cv::Point2d, 4> move_edges_in(const std::array<cv::Point2d, 4>& c,
+                                         const EdgeShifts& shift_px) {
+  const cv::Point2d centre = (c[0] + c[1] + c[2] + c[3]) / 4.0;
+  std::array<cv::Point2d, 4> normal;
+  for (int e = 0; e < 4; ++e) {
+    const cv::Point2d d = c[(e + 1) % 4] - c[e];
+    cv::Point2d n(d.y, -d.x);
+    n /= std::max(std::hypot(n.x, n.y), 1e-12);
+    normal[static_cast<std::size_t>(e)] = n.dot(c[e] - centre) < 0 ? -n : n;
+  }
+  std::array<cv::Point2d, 4> out = c;
+  for (int k = 0; k < 4; ++k) {
+    // Corner k lies on edges k - 1 and k: the step s with n_a . s = -shift_a, n_b . s = -shift_b.
+    const auto a = static_cast<std::size_t>((k + 3) % 4), b = static_cast<std::size_t>(k);
+    const double det = normal[a].cross(normal[b]);
+    if (std::abs(det) < 1e-9) continue;
+    // Edge a ends at corner k, edge b starts there.
+    const double ra = -shift_px[a][1], rb = -shift_px[b][0];
+    out[b] += cv::Point2d((ra * normal[b].y - rb * normal[a].y) / det,
+                          (rb * normal[a].x - ra * normal[b].x) / det);
+  }
+  return out;
+}
+
 CornerJacobian corner_jacobian(const CameraModel& cam, const Pose& T, double size_m) {
   CornerJacobian J;
   const Mat3 R = T.rotation();
@@ -79,7 +103,8 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
     if (!std::isfinite(p.x) || !std::isfinite(p.y))
       return fail("tag corner is not a finite number");
   if (!(size_m > 0) || !(sigma > 0)) return fail("tag size and corner sigma must be positive");
-  std::vector<cv::Point2d> image(c.begin(), c.end());
+  const auto moved = move_edges_in(c, noise.edge_shift_px);
+  std::vector<cv::Point2d> image(moved.begin(), moved.end());
   if (cam.has_distortion()) cv::undistortPoints(image, image, cam.K(), cam.distortion, cv::noArray(), cam.K());
   const double area = std::abs((image[2] - image[0]).cross(image[3] - image[1])) / 2;
   if (!(area > 4)) return fail(fmt::format("tag quad is degenerate (area {:.2f} px^2)", area));
@@ -95,7 +120,7 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
   Eigen::Matrix<double, 8, 8> corner_cov =
       noise.radial_sigma_px * noise.radial_sigma_px * radial * radial.transpose();
   for (int i = 0; i < 8; ++i) {
-    const double extra = noise.narrow_px[static_cast<std::size_t>(i / 2)];
+    const double extra = noise.extra_px[static_cast<std::size_t>(i / 2)];
     corner_cov(i, i) += sigma * sigma + extra * extra;
   }
 
@@ -104,19 +129,28 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
   for (const Vec3& X : object) obj.emplace_back(X.x(), X.y(), X.z());
   const cv::Mat K(cam.K());
   std::vector<cv::Mat> rvecs, tvecs;
-  std::vector<PoseSolution> solutions;
+  std::vector<PoseSolution> solutions, unrefined;
   try {
     cv::solvePnPGeneric(obj, image, K, cv::noArray(), rvecs, tvecs, false, cv::SOLVEPNP_IPPE_SQUARE);
     for (std::size_t i = 0; i < rvecs.size(); ++i) {
+      const Pose ippe = pose_of(rvecs[i], tvecs[i]);
       cv::solvePnPRefineLM(obj, image, K, cv::noArray(), rvecs[i], tvecs[i]);
       const Pose T = pose_of(rvecs[i], tvecs[i]);
       const double e = sse(cam, T, object, image);
-      if (std::isfinite(e)) solutions.push_back({T, e});
+      if (std::isfinite(e)) solutions.push_back({T, e}), unrefined.push_back({ippe, sse(cam, ippe, object, image)});
     }
   } catch (const cv::Exception& e) {
     return fail(fmt::format("pose from tag corners failed: {}", e.what()));
   }
   if (solutions.empty()) return fail("no pose puts the tag in front of the camera");
+  if (solutions.size() == 2 && boxminus(solutions[1].T_camera_tag, solutions[0].T_camera_tag).norm() < 1e-6) {
+    // Near face-on both of IPPE's solutions can slide into one minimum under LM: the
+    // tilt's sign is then still unknown, so the other solution is IPPE's own, unpolished
+    // (the one farther from the polished pose).
+    const auto far = [&](const PoseSolution& s) { return boxminus(s.T_camera_tag, solutions[0].T_camera_tag).norm(); };
+    solutions[1] = far(unrefined[0]) > far(unrefined[1]) ? unrefined[0] : unrefined[1];
+    solutions[1].sse_px2 = std::max(solutions[1].sse_px2, solutions[0].sse_px2);
+  }
   std::sort(solutions.begin(), solutions.end(),
             [](const PoseSolution& a, const PoseSolution& b) { return a.sse_px2 < b.sse_px2; });
 

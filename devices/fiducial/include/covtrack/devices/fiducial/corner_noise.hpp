@@ -3,7 +3,7 @@
 // devices/fiducial/README.md, "Corner noise model"):
 //
 //   sigma_corner^2 = floor_px^2 + gain_px^2 * (noise / contrast)^2 * 16 / max(16, L / 8)
-//                    + aligned_px^2 * A
+//                    + aligned_px^2 * A + shift_sigma_px^2 * (reach_a^2 + reach_b^2)
 //
 // noise: the image's noise (grey levels), contrast: the grey-level step across the tag's
 // border, L: the tag's mean edge length (px). AprilTag fits each edge to max(16, L/8)
@@ -13,15 +13,26 @@
 // exp(-(angle to the nearest axis / 3 deg)^2)). AprilTag samples the edge gradient at
 // whole pixels, so an edge along a pixel row sees the same sub-pixel phase all along and
 // its bias does not average out (measured: 0.1 px at 0 deg against 0.05 px at 2-10 deg).
+//
+// Edge shift: the black border is one cell thick; where a white data cell lines its
+// inside, the blurred image rises again within a few pixels of the edge, and AprilTag's
+// edge refinement (gradients sampled up to 3 px either side) finds the edge too far out.
+// Per edge, reach = exp(-shift_falloff (border / blur)^2), border the black border's
+// width along the edge's normal (px) and blur the measured edge blur (px); the edge is
+// moved back in by shift_px * white * reach before the pose (white: where white cells
+// line that edge, from the tag's code, as a straight line along it: the shift is
+// evaluated at each end, so cells near one corner tilt the line). It is a bias of the
+// view (up to 0.45 px at a corner of a rendered small steep tag), constant across noise
+// draws: it is corrected, and what the correction misses enters each corner's variance
+// as shift_sigma_px^2 times the squared reaches of its two edges (a, b). (Entered instead
+// as an error of each edge's whole line, moving both its corners together, this term and
+// the aligned one made validation views up to 3x over-confident.)
+//
 // On top of that, all four corners share one error along their radial directions (away
 // from the quad's centre): the detector sees the square a little too small or too large,
 // by radial_bias_px on average (corrected before the pose) with a spread of
 // radial_sigma_px common to the four corners. Independent corner noise would average it
 // away and make the depth over-confident, so it enters Sigma_c as a rank-one term.
-// Each corner also gets narrow_px^2 (4 px / band)^power, band the quiet band beyond its
-// narrower edge (quiet_band_px): where foreshortening squeezes the uniform margin beyond
-// the black border to a few pixels, AprilTag's edge refinement reaches past it and the
-// corner is biased (a constant of the view, up to 0.45 px on rendered tags).
 // The floor holds what else noise does not explain (blur, aliasing, the lens).
 // A calibration on rendered views with known truth measures the coefficients
 // (fit_corner_noise in noise_calibration.hpp, run by tests/devices/fiducial_nees_test).
@@ -29,7 +40,23 @@
 
 #include <opencv2/core.hpp>
 
+#include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "covtrack/devices/fiducial/tag_pose.hpp"
+
 namespace covtrack::fiducial {
+
+// What the model reads from one detection in one frame: all of it measured from the
+// image and the detection, by the driver and by the calibration alike.
+struct CornerInputs {
+  double image_noise = 0;     // grey levels (estimate_image_noise)
+  double contrast = 0;        // grey levels (tag_contrast)
+  double edge_length_px = 0;  // mean edge length
+  double axis_alignment = 0;  // A (edge_axis_alignment)
+  double blur_px = 1;         // edge_blur_px
+  std::array<double, 4> border_px{};   // per edge: the black border's width (border_width_px)
+  std::array<std::array<double, 2>, 4> inner_white{};  // per edge, at its start and end:
+                                                       // TagFamily::border_inner_white
+};
 
 struct CornerNoiseModel {
   double gain_px = 1.0;
@@ -37,22 +64,26 @@ struct CornerNoiseModel {
   double aligned_px = 0.1;
   double radial_bias_px = 0;   // mean outward error of every corner (negative: inward)
   double radial_sigma_px = 0;  // spread of that common radial error
-  double narrow_px = 0;        // a corner's extra error where its quiet band is narrow
-  double narrow_power = 6;     // how fast that error grows as the band narrows
+  double shift_px = 0;         // outward edge shift with all-white cells inside, zero border
+  double shift_falloff = 0.16;  // how fast it fades with border / blur (see above)
+  double shift_sigma_px = 0;   // the shift correction's uncertainty at reach 1
 
-  // The extra standard deviation (px) of a corner whose narrower edge has a quiet band
-  // of `quiet_band_px`: narrow_px * (kNarrowBandPx / band)^(power / 2).
-  double narrow_sigma_px(double quiet_band_px) const;
-  // The same for the four corners (corner_quiet_band_px).
-  std::array<double, 4> narrow_sigmas_px(const std::array<double, 4>& corner_band_px) const;
-  static constexpr double kNarrowBandPx = 4;
-
-  // One corner coordinate's standard deviation (px), the same along u and v.
-  double sigma_px(double image_noise, double contrast, double edge_length_px,
-                  double axis_alignment) const;
+  // Per edge: exp(-shift_falloff (border / blur)^2).
+  std::array<double, 4> edge_reach(const CornerInputs& in) const;
+  // Per edge, at its start and end corner: the predicted outward shift (px),
+  // shift_px * white * reach.
+  EdgeShifts edge_shift_px(const CornerInputs& in) const;
+  // One corner coordinate's standard deviation (px) without the edge shift's term.
+  double sigma_px(const CornerInputs& in) const;
+  // Everything estimate_tag_pose needs.
+  CornerNoise noise(const CornerInputs& in) const;
   // The noise-driven factor the gain multiplies: (noise / contrast)^2 * 16 / max(16, L/8).
   static double noise_term(double image_noise, double contrast, double edge_length_px);
 };
+
+// All inputs for one detection; `image_noise` is the frame's (computed once per frame).
+CornerInputs measure_corner_inputs(const cv::Mat& gray, const Detection& detection,
+                                   const TagFamily& family, double image_noise);
 
 // The image's noise standard deviation (grey levels), from the median absolute response
 // of a 3x3 second-difference filter on a sparse grid (robust to the few edge pixels).
@@ -63,19 +94,21 @@ double estimate_image_noise(const cv::Mat& gray);
 double tag_contrast(const cv::Mat& gray, const std::array<cv::Point2d, 4>& corners_px,
                     int cells_across_border);
 
+// How wide the tag's edges are (px): the Gaussian blur sigma that gives the measured
+// peak slope across the border edges for the measured `contrast` (tag_contrast). It
+// includes the lens blur, the pixel's area and the interpolation.
+double edge_blur_px(const cv::Mat& gray, const std::array<cv::Point2d, 4>& corners_px,
+                    double contrast);
+
 // A in the model above: 1 when every edge lies along a pixel row or column, ~0 beyond 6 deg.
 double edge_axis_alignment(const std::array<cv::Point2d, 4>& corners_px);
 
 double mean_edge_length_px(const std::array<cv::Point2d, 4>& corners_px);
 
-// Width (px) of the quiet band beyond each edge of the detected square: `quiet_cells`
-// cells (of cells_across_border per edge) measured outward from the edge's midpoint
-// through the quad's perspective, as the distance to the edge's line. Edge e runs from
-// corner e to corner e + 1.
-std::array<double, 4> quiet_band_px(const std::array<cv::Point2d, 4>& corners_px,
-                                    int cells_across_border, double quiet_cells);
-// Per corner, the narrower band of its two edges (corner k joins edges k - 1 and k).
-std::array<double, 4> corner_quiet_band_px(const std::array<cv::Point2d, 4>& corners_px,
-                                           int cells_across_border, double quiet_cells);
+// Width (px) of the one-cell black border inside each edge of the detected square (of
+// cells_across_border cells per edge), along the edge's normal at its midpoint, through
+// the quad's perspective. Edge e runs from corner e to corner e + 1.
+std::array<double, 4> border_width_px(const std::array<cv::Point2d, 4>& corners_px,
+                                      int cells_across_border);
 
 }  // namespace covtrack::fiducial

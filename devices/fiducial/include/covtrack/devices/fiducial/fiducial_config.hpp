@@ -17,7 +17,6 @@ struct FiducialConfig {
   std::string calibration;     // OpenCV calibration file
   DetectorOptions detector;
   CornerNoiseModel noise;
-  double paper_margin_cells = 1;  // white paper beyond the family's white ring (cells)
   double ambiguity_chi2 = 16;
   double rate_hz = 30;         // files: replay pace (0: as fast as possible); cameras: ignored
   bool loop = true;            // files: start over at the end

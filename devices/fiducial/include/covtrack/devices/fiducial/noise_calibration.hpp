@@ -27,12 +27,17 @@ struct CalibrationView {
 struct ViewDraw {
   Pose T_camera_tag_true = Pose::Identity();
   std::optional<Detection> detection;
-  double image_noise = 0, contrast = 0, edge_length_px = 0, axis_alignment = 0;
-  double corner_sq_error_px2 = 0;  // mean over the 8 coordinates, common radial part removed
-  std::array<double, 4> corner_sq_errors_px2{};  // per corner (u^2 + v^2), radial part removed
-  std::array<double, 4> corner_band_px{};        // per corner: quiet band (corner_quiet_band_px)
-  double radial_error_px = 0;      // the four corners' mean outward error
+  CornerInputs inputs;                   // measured as the driver measures them
+  std::array<cv::Point2d, 4> truth_px{};  // where the four corners truly project
 };
+
+// One draw's corner errors after the model's edge-shift correction (not its radial bias).
+struct CornerErrors {
+  std::array<cv::Point2d, 4> error_px{};  // corrected corner - truth
+  double radial_px = 0;                   // the four corners' mean outward error
+  std::array<double, 4> sq_px2{};         // per corner (u^2 + v^2), the common radial part removed
+};
+CornerErrors corner_errors(const CornerNoiseModel& model, const ViewDraw& draw);
 
 // Renders, adds noise and detects `draws` times (on `threads` threads, each with its
 // own detector); deterministic for a given seed.
@@ -43,13 +48,16 @@ Result<std::vector<ViewDraw>> draw_view(const CameraModel& camera, const Detecto
 // The model's corner noise for what this draw's detection saw.
 CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& draw);
 
-// Three stages. (0) The radial bias and spread: mean and standard deviation of the
-// per-draw common radial error. (1) The four corner coefficients (floor, gain, aligned,
-// narrow) minimising the sum over views of log(view's corner NEES per coordinate)^2, so
-// that over- and under-confident views weigh alike; the narrow term's power is the best
-// of a few. (2) The four corners' errors are not independent (neighbours share an
-// edge), so the pooled pose NEES over the calibration views is brought to 6 by one
-// common factor on all coefficients.
+// Four stages. (0) The edge shift: shift_px and shift_falloff by least squares of each
+// edge's outward error (mean of its two corners along its normal) on white * reach.
+// (1) The radial bias and spread: mean and standard deviation of the per-draw common
+// radial error after that correction. (2) The four corner coefficients (floor, gain,
+// aligned, shift_sigma) minimising the sum over views of log(view's corner NEES per
+// coordinate)^2, so that over- and under-confident views weigh alike. (3) The four
+// corners' errors are not independent (neighbours share an edge), so one common factor
+// on the spreads brings the calibration views' pose NEES to 6, in geometric mean over views
+// (the pooled mean would be set by the few most over-confident views).
+
 CornerNoiseModel fit_corner_noise(const CameraModel& camera,
                                   const std::vector<CalibrationView>& views,
                                   const std::vector<std::vector<ViewDraw>>& draws);

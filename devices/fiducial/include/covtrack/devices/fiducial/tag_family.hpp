@@ -2,6 +2,7 @@
 // An AprilTag family opened by name (tag36h11, tagStandard41h12, ...), closed when the
 // last user lets go. The renderer draws tags from the family's own code bits, the
 // detector looks for them.
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,10 +29,14 @@ class TagFamily {
   // across the whole printed tag (which may extend beyond that square).
   int cells_across_border() const;
   int cells_across_total() const;
-  // Cells of one uniform shade just beyond the detected square's edge: the family's white
-  // ring plus the paper around the print, or the one black ring of a reversed-border
-  // family (its data bits follow). The detector's edge refinement needs a few pixels of it.
-  double quiet_cells(double paper_margin_cells) const;
+  // Per edge of the detected square (edge k from corner k to k + 1, AprilTag's corner
+  // order), where the data cells lining the inside of the one-cell black border are
+  // white: there the border is only one cell thick and the detector's edge refinement is
+  // pulled outward (corner_noise.hpp). As the detector fits a straight line along the
+  // edge, so is "white" (1 for a white cell, 0 elsewhere, the border's corner cells
+  // included) fitted by a straight line along it; returned at the edge's start and end.
+  // All zero for reversed-border families, whose detected edge has no such border inside.
+  std::array<std::array<double, 2>, 4> border_inner_white(int id) const;
   // The printed tag `id` as total x total cells, 0 black and 255 white, row 0 at the top.
   Result<cv::Mat> cells(int id) const;
 

@@ -5,10 +5,14 @@
 // A square seen in perspective has two poses that fit (the tilt ambiguity); both come
 // from OpenCV's IPPE_SQUARE and are polished by Levenberg-Marquardt. The covariance is
 // (J^T Sigma_c^-1 J)^-1, J the Jacobian of the four projected corners w.r.t. xi, and
-// Sigma_c = diag(sigma^2 + narrow_k^2) + radial_sigma^2 r r^T (r: the corners' unit
-// radial directions stacked; narrow_k: corner k's narrow-band term; see corner_noise.hpp). Corners are first moved by -radial_bias along r. When the second pose fits nearly as well (its extra
+// Sigma_c = diag(sigma^2 + extra_k^2) + radial_sigma^2 r r^T (r: the corners' unit
+// radial directions stacked; extra_k: corner k's edge-shift term; see corner_noise.hpp).
+// Corners are first corrected: each edge's line is moved back in by its predicted
+// outward shift, then every corner by -radial_bias along r. When the second pose fits
+// nearly as well (its extra
 // squared reprojection error below `ambiguity_chi2` corner variances) the covariance
-// gets the outer product of the step to it, so that it covers both.
+// gets the outer product of the step to it, so that it covers both. Near face-on, LM can
+// pull both solutions into one minimum; the second is then IPPE's other one, unpolished.
 #include <array>
 #include <optional>
 
@@ -40,13 +44,22 @@ struct TagPose {
 // d(corner pixels)/d(xi) at T_camera_tag, rows u0 v0 u1 v1 ..., pinhole projection.
 CornerJacobian corner_jacobian(const CameraModel& camera, const Pose& T_camera_tag, double size_m);
 
+// Per edge (corner k to k + 1): its outward shift (px) at its start and at its end.
+using EdgeShifts = std::array<std::array<double, 2>, 4>;
+
 // What the noise model says about one tag's corners.
 struct CornerNoise {
   double sigma_px = 0.1;       // independent, per coordinate
   double radial_bias_px = 0;   // common outward error, removed before the pose
   double radial_sigma_px = 0;  // common outward error's spread
-  std::array<double, 4> narrow_px{};  // per corner, extra independent error (narrow quiet band)
+  std::array<double, 4> extra_px{};   // per corner, extra independent error (edge shift)
+  EdgeShifts edge_shift_px{};  // outward shifts of the edges' ends, removed
 };
+
+// The corners of the quad whose edges are those of `corners_px` moved in along their
+// outward normals by `shift_px` at each end (edge k runs from corner k to corner k + 1).
+std::array<cv::Point2d, 4> move_edges_in(const std::array<cv::Point2d, 4>& corners_px,
+                                         const EdgeShifts& shift_px);
 
 // sigma^2 (J^T J)^-1: the pose covariance from independent corner noise of sigma px.
 Mat6 pose_covariance(const CornerJacobian& J, double corner_sigma_px);
