@@ -35,19 +35,6 @@ ViewDraw one_draw(const CameraModel& camera, TagDetector& detector, const Calibr
   return d;
 }
 
-// Unit outward normals of the quad's edges (edge k from corner k to k + 1).
-std::array<cv::Point2d, 4> outward_normals(const std::array<cv::Point2d, 4>& c) {
-  const cv::Point2d centre = (c[0] + c[1] + c[2] + c[3]) / 4.0;
-  std::array<cv::Point2d, 4> normal;
-  for (std::size_t e = 0; e < 4; ++e) {
-    const cv::Point2d d = c[(e + 1) % 4] - c[e];
-    cv::Point2d n(d.y, -d.x);
-    n /= std::max(std::hypot(n.x, n.y), 1e-12);
-    normal[e] = n.dot(c[e] - centre) < 0 ? -n : n;
-  }
-  return normal;
-}
-
 }  // namespace
 
 Result<std::vector<ViewDraw>> draw_view(const CameraModel& camera, const DetectorOptions& options,
@@ -204,7 +191,7 @@ void fit_edge_shift(CornerNoiseModel& m, const std::vector<std::vector<ViewDraw>
     for (const ViewDraw& d : draws) {
       if (!d.detection) continue;
       const auto& c = d.detection->corners_px;
-      const auto normal = outward_normals(c);
+      const auto normal = edge_outward_normals(c);
       for (std::size_t e = 0; e < 4; ++e) {
         const double x = d.inputs.border_px[e] / d.inputs.blur_px;
         if (!std::isfinite(x)) continue;

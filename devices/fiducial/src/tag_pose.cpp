@@ -42,16 +42,21 @@ double sse(const CameraModel& cam, const Pose& T, const std::array<Vec3, 4>& obj
 
 }  // namespace
 
-std::array<cv::Point2d, 4> move_edges_in(const std::array<cv::Point2d, 4>& c,
-                                         const EdgeShifts& shift_px) {
+std::array<cv::Point2d, 4> edge_outward_normals(const std::array<cv::Point2d, 4>& c) {
   const cv::Point2d centre = (c[0] + c[1] + c[2] + c[3]) / 4.0;
   std::array<cv::Point2d, 4> normal;
-  for (int e = 0; e < 4; ++e) {
+  for (std::size_t e = 0; e < 4; ++e) {
     const cv::Point2d d = c[(e + 1) % 4] - c[e];
     cv::Point2d n(d.y, -d.x);
     n /= std::max(std::hypot(n.x, n.y), 1e-12);
-    normal[static_cast<std::size_t>(e)] = n.dot(c[e] - centre) < 0 ? -n : n;
+    normal[e] = n.dot(c[e] - centre) < 0 ? -n : n;
   }
+  return normal;
+}
+
+std::array<cv::Point2d, 4> move_edges_in(const std::array<cv::Point2d, 4>& c,
+                                         const EdgeShifts& shift_px) {
+  const auto normal = edge_outward_normals(c);
   std::array<cv::Point2d, 4> out = c;
   for (int k = 0; k < 4; ++k) {
     // Corner k lies on edges k - 1 and k: the step s with n_a . s = -shift_a, n_b . s = -shift_b.

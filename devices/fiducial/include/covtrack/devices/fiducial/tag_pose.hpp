@@ -56,6 +56,9 @@ struct CornerNoise {
   EdgeShifts edge_shift_px{};  // outward shifts of the edges' ends, removed
 };
 
+// Unit outward normals of the quad's edges (edge k runs from corner k to corner k + 1).
+std::array<cv::Point2d, 4> edge_outward_normals(const std::array<cv::Point2d, 4>& corners_px);
+
 // The corners of the quad whose edges are those of `corners_px` moved in along their
 // outward normals by `shift_px` at each end (edge k runs from corner k to corner k + 1).
 std::array<cv::Point2d, 4> move_edges_in(const std::array<cv::Point2d, 4>& corners_px,
