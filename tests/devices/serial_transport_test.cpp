@@ -3,6 +3,10 @@
 // paths that are not serial devices at all.
 #include <gtest/gtest.h>
 #include <fcntl.h>
+#include <sched.h>
+#include <sys/ioctl.h>
+#include <sys/wait.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -15,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "covtrack/devices/serial/device_holders.hpp"
 #include "covtrack/devices/serial/pseudo_terminal.hpp"
 #include "covtrack/devices/serial/serial_port.hpp"
 
@@ -134,6 +139,73 @@ TEST(SerialTransport, RefusedOpenReportsTheRealError) {
   ASSERT_FALSE(port);
   EXPECT_NE(port.error().message.find(std::strerror(EIO)), std::string::npos) << port.error().message;
   EXPECT_EQ(port.error().message.find(std::strerror(EBADF)), std::string::npos) << port.error().message;
+}
+
+TEST(SerialTransport, HoldersOfADeviceAreNamed) {
+  auto pty = PseudoTerminal::create(link_path("holders"));
+  ASSERT_TRUE(pty) << pty.error().message;
+  const std::string me = "(pid " + std::to_string(::getpid()) + ")";
+  const auto names_me = [&] {
+    for (const std::string& h : covtrack::serial::processes_holding(link_path("holders")))
+      if (h.find(me) != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_FALSE(names_me()) << "only the master is open, and it is another device";
+  const int slave = ::open(pty->slave_path().c_str(), O_RDWR | O_NOCTTY);
+  ASSERT_GE(slave, 0);
+  EXPECT_TRUE(names_me()) << "through the symlink, the slave held here";
+  ::close(slave);
+  EXPECT_FALSE(names_me());
+  EXPECT_TRUE(covtrack::serial::processes_holding("/nonexistent/tty").empty());
+}
+
+// As under `unshare --map-root-user` (the e2e tests' namespaces): root there cannot
+// override TIOCEXCL, so a port held exclusively by one process refuses another with
+// EBUSY, and the message says who holds it. A child enters a user namespace and holds
+// the port; its own child tries to open it.
+TEST(SerialTransport, BusyPortNamesWhoHoldsIt) {
+  const std::string path = link_path("busy");  // the children's pids differ
+  auto pty = PseudoTerminal::create(path);
+  ASSERT_TRUE(pty) << pty.error().message;
+  int pipe_fds[2];
+  ASSERT_EQ(::pipe(pipe_fds), 0);
+  const pid_t holder = ::fork();
+  ASSERT_GE(holder, 0);
+  if (holder == 0) {
+    ::close(pipe_fds[0]);
+    const auto write_file = [](const char* file, const char* text) {
+      const int fd = ::open(file, O_WRONLY);
+      const bool ok = fd >= 0 && ::write(fd, text, std::strlen(text)) == static_cast<ssize_t>(std::strlen(text));
+      if (fd >= 0) ::close(fd);
+      return ok;
+    };
+    const auto say = [&](const std::string& message) {
+      (void)!::write(pipe_fds[1], message.data(), message.size());
+      ::_exit(0);
+    };
+    if (::unshare(CLONE_NEWUSER) != 0 || !write_file("/proc/self/setgroups", "deny") ||
+        !write_file("/proc/self/uid_map", "0 0 1\n") || !write_file("/proc/self/gid_map", "0 0 1\n"))
+      say("no user namespace");
+    const int held = ::open(pty->slave_path().c_str(), O_RDWR | O_NOCTTY);
+    if (held < 0 || ::ioctl(held, TIOCEXCL) != 0) say("cannot hold the port");
+    const pid_t opener = ::fork();
+    if (opener == 0) {
+      ::close(held);  // inherited: only the parent holds it
+      auto port = SerialPort::open({.path = path, .baud = 19200});
+      say(port ? "opened" : port.error().message);
+    }
+    ::waitpid(opener, nullptr, 0);
+    ::_exit(0);
+  }
+  ::close(pipe_fds[1]);
+  std::string message;
+  char buf[512];
+  for (ssize_t n; (n = ::read(pipe_fds[0], buf, sizeof buf)) > 0;) message.append(buf, static_cast<std::size_t>(n));
+  ::close(pipe_fds[0]);
+  ::waitpid(holder, nullptr, 0);
+  if (message == "no user namespace") GTEST_SKIP() << "this machine gives no user namespace";
+  EXPECT_NE(message.find(std::strerror(EBUSY)), std::string::npos) << message;
+  EXPECT_NE(message.find("(pid " + std::to_string(holder) + ")"), std::string::npos) << message;
 }
 
 TEST(SerialTransport, UnsupportedBaudIsRejected) {

@@ -10,11 +10,14 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <vector>
 #include <libserial/SerialPort.h>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "covtrack/devices/serial/baud_rate.hpp"
+#include "covtrack/devices/serial/device_holders.hpp"
 
 namespace covtrack::serial {
 namespace {
@@ -76,7 +79,11 @@ std::string open_failure_reason(const std::string& path) {
   }
   const int error = errno;
   const std::string text = std::strerror(error);
-  if (error == EBUSY) return text + " (another program holds it exclusively)";
+  if (error == EBUSY) {
+    const std::vector<std::string> holders = processes_holding(path);
+    if (holders.empty()) return text + " (another program holds it exclusively)";
+    return fmt::format("{} (held exclusively; open in: {})", text, fmt::join(holders, ", "));
+  }
   if (error == EACCES) return text + " (add the user to the 'dialout' group?)";
   return text;
 }
