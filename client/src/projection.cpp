@@ -102,7 +102,10 @@ void exp_sigma_poses(const Mat3& R0, const Vec3& t0, const Mat6& S, std::array<R
     const double dot = x * rx[i] + y * ry[i] + z * rz[i], lin = 1 - c[i] * t2[i];
     const double odd[3] = {lin * rx[i] + c[i] * dot * x, lin * ry[i] + c[i] * dot * y, lin * rz[i] + c[i] * dot * z};
     const double even[3] = {b[i] * (y * rz[i] - z * ry[i]), b[i] * (z * rx[i] - x * rz[i]), b[i] * (x * ry[i] - y * rx[i])};
+    // Unrolled, so that the loop over the lanes is the only loop left to vectorise.
+#pragma GCC unroll 3
     for (int r = 0; r < 3; ++r) {
+#pragma GCC unroll 3
       for (int k = 0; k < 3; ++k) {
         plus[3 * r + k][i] = R0(r, 0) * Ep[k] + R0(r, 1) * Ep[3 + k] + R0(r, 2) * Ep[6 + k];
         minus[3 * r + k][i] = R0(r, 0) * Em[k] + R0(r, 1) * Em[3 + k] + R0(r, 2) * Em[6 + k];
