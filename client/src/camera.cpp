@@ -13,24 +13,18 @@ Vec2 Camera::project(const Vec3& p, Mat23* J_pixel_point) const {
   const double iz = 1.0 / p.z();
   const double x = p.x() * iz, y = p.y() * iz;
   Vec2 pixel;
-  pixel_of_normalised(x, y, pixel.x(), pixel.y());
-  if (J_pixel_point) {
-    const double r2 = x * x + y * y;
-    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
-    // Chain rule: pixel <- distorted (xd, yd) <- normalised (x, y) <- point.
-    const double dradial_dr2 = k1 + r2 * (2 * k2 + 3 * k3 * r2);
-    const double drad_dx = 2 * x * dradial_dr2, drad_dy = 2 * y * dradial_dr2;
-    Mat2 D;
-    D(0, 0) = radial + x * drad_dx + 2 * p1 * y + 6 * p2 * x;
-    D(0, 1) = x * drad_dy + 2 * p1 * x + 2 * p2 * y;
-    D(1, 0) = y * drad_dx + 2 * p1 * x + 2 * p2 * y;
-    D(1, 1) = radial + y * drad_dy + 6 * p1 * y + 2 * p2 * x;
-    Mat23 N;
-    N << iz, 0, -x * iz, 0, iz, -y * iz;
-    Mat2 F;
-    F << fx, 0, 0, fy;
-    *J_pixel_point = F * D * N;
+  if (!J_pixel_point) {
+    pixel_of_normalised(x, y, pixel.x(), pixel.y());
+    return pixel;
   }
+  // Chain rule: pixel <- normalised (x, y) <- point.
+  double d[4];
+  pixel_of_normalised(x, y, pixel.x(), pixel.y(), d);
+  Mat2 D;
+  D << d[0], d[1], d[2], d[3];
+  Mat23 N;
+  N << iz, 0, -x * iz, 0, iz, -y * iz;
+  *J_pixel_point = D * N;
   return pixel;
 }
 

@@ -226,6 +226,88 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
   }
 }
 
+// The first-order path in the same blocks: per vertex J = J_camera R [I, -skew(p)]
+// (pixel_jacobian_wrt_perturbation) and J C J^T, written out over the block's lanes.
+struct LinearBlock {
+  double u[kBlock], v[kBlock], z[kBlock];
+  double cuu[kBlock], cuv[kBlock], cvv[kBlock];
+};
+
+COVTRACK_VECTOR_CLONES
+void linear_block(const Camera& camera, const Pose& T, const Mat6& covariance,
+                  const double (&px)[kBlock], const double (&py)[kBlock],
+                  const double (&pz)[kBlock], LinearBlock& out) {
+  const Camera cam = camera;  // local copies: stores through `out` cannot change them
+  double R[9], t[3], C[36];
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) R[3 * r + k] = T.linear()(r, k);
+    t[r] = T.translation()[r];
+  }
+  for (int a = 0; a < 6; ++a)
+    for (int b = 0; b < 6; ++b) C[6 * a + b] = covariance(a, b);
+  for (int j = 0; j < kBlock; ++j) {
+    const double x = R[0] * px[j] + R[1] * py[j] + R[2] * pz[j] + t[0];
+    const double y = R[3] * px[j] + R[4] * py[j] + R[5] * pz[j] + t[1];
+    const double z = R[6] * px[j] + R[7] * py[j] + R[8] * pz[j] + t[2];
+    const double iz = 1 / z, xn = x * iz, yn = y * iz;
+    double d[4], u, v;
+    cam.pixel_of_normalised(xn, yn, u, v, d);
+    // d(pixel)/d(camera point) = d(pixel)/d(xn, yn) [iz 0 -xn iz; 0 iz -yn iz], then times R.
+    const double c[2][3] = {{d[0] * iz, d[1] * iz, -(d[0] * xn + d[1] * yn) * iz},
+                            {d[2] * iz, d[3] * iz, -(d[2] * xn + d[3] * yn) * iz}};
+    double J[2][6];
+#pragma GCC unroll 2
+    for (int r = 0; r < 2; ++r) {
+#pragma GCC unroll 3
+      for (int k = 0; k < 3; ++k) J[r][k] = c[r][0] * R[k] + c[r][1] * R[3 + k] + c[r][2] * R[6 + k];
+      // -(row x p): the rotation part, row [-skew(p)] applied from the left.
+      J[r][3] = py[j] * J[r][2] - pz[j] * J[r][1];
+      J[r][4] = pz[j] * J[r][0] - px[j] * J[r][2];
+      J[r][5] = px[j] * J[r][1] - py[j] * J[r][0];
+    }
+    double CJ0[6], CJ1[6];
+#pragma GCC unroll 6
+    for (int a = 0; a < 6; ++a) {
+      CJ0[a] = 0, CJ1[a] = 0;
+#pragma GCC unroll 6
+      for (int b = 0; b < 6; ++b) CJ0[a] += C[6 * a + b] * J[0][b], CJ1[a] += C[6 * a + b] * J[1][b];
+    }
+    double uu = 0, uv = 0, vv = 0;
+#pragma GCC unroll 6
+    for (int a = 0; a < 6; ++a) uu += J[0][a] * CJ0[a], uv += J[0][a] * CJ1[a], vv += J[1][a] * CJ1[a];
+    out.u[j] = u, out.v[j] = v, out.z[j] = z;
+    out.cuu[j] = uu, out.cuv[j] = uv, out.cvv[j] = vv;
+  }
+}
+
+void project_linear(const Camera& camera, const UncertainPose& pose,
+                    std::span<const Vec3> points, const ProjectionOptions& o,
+                    const ProjectionFlags& shared, std::vector<ProjectedVertex>& out) {
+  const bool add_intrinsic = o.add_intrinsic_uncertainty && !camera.intrinsic_sigmas_px.isZero();
+  LinearBlock b;
+  for (std::size_t first = 0; first < points.size(); first += kBlock) {
+    const int count = static_cast<int>(std::min<std::size_t>(kBlock, points.size() - first));
+    double px[kBlock], py[kBlock], pz[kBlock];
+    for (int j = 0; j < kBlock; ++j) {
+      const Vec3& p = points[first + (j < count ? j : 0)];
+      px[j] = p.x(), py[j] = p.y(), pz[j] = p.z();
+    }
+    linear_block(camera, pose.T, pose.covariance, px, py, pz, b);
+    for (int j = 0; j < count; ++j) {
+      ProjectedVertex& v = out.emplace_back();
+      v.depth_m = b.z[j];
+      v.flags = shared;
+      if (b.z[j] < o.near_m) {
+        v.flags.behind_camera = true;
+        continue;
+      }
+      v.mean_px = Vec2(b.u[j], b.v[j]);
+      v.covariance_px2 << b.cuu[j], b.cuv[j], b.cuv[j], b.cvv[j];
+      if (add_intrinsic) v.covariance_px2 += camera.intrinsic_covariance_at(v.mean_px);
+    }
+  }
+}
+
 void project_unscented(const Camera& camera, const UncertainPose& pose,
                        std::span<const Vec3> points, const ProjectionOptions& o,
                        const ProjectionFlags& shared, std::vector<ProjectedVertex>& out) {
@@ -276,9 +358,12 @@ void project_vertices(const Camera& camera, const UncertainPose& pose,
   shared.unbounded = pose.unbounded;
   shared.rotation_too_uncertain =
       use_covariance && rotation_too_uncertain(pose.covariance, o.max_rotation_sigma_rad);
-  if (o.method == ProjectionMethod::unscented && use_covariance)
-    return project_unscented(camera, pose, points, o, shared, out);
+  if (use_covariance)
+    return o.method == ProjectionMethod::unscented
+               ? project_unscented(camera, pose, points, o, shared, out)
+               : project_linear(camera, pose, points, o, shared, out);
 
+  // LOST: the pixel of the last estimate, no covariance.
   for (const Vec3& p : points) {
     ProjectedVertex& v = out.emplace_back();
     const Vec3 pc = pose.T * p;
@@ -289,11 +374,6 @@ void project_vertices(const Camera& camera, const UncertainPose& pose,
       continue;
     }
     v.mean_px = camera.project(pc);
-    if (use_covariance) {
-      const Mat26 J = pixel_jacobian_wrt_perturbation(camera, pose.T, p);
-      v.covariance_px2 = J * pose.covariance * J.transpose();
-      if (o.add_intrinsic_uncertainty) v.covariance_px2 += camera.intrinsic_covariance_at(v.mean_px);
-    }
   }
 }
 

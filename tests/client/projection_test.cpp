@@ -202,7 +202,8 @@ TEST(Projection, IntrinsicSigmasAddCovariance) {
 }
 
 // Vertices are projected 8 at a time: 19 vertices (two full blocks and a short one) give
-// each vertex exactly what it gets alone, flags included, whatever its neighbours.
+// each vertex exactly what it gets alone, flags included, whatever its neighbours; both
+// methods give their formulas' values.
 TEST(Projection, BlocksGiveWhatEachVertexGetsAlone) {
   const Camera cam = test::example_camera();
   const UncertainPose pose{pose_from(Vec3(0.05, -0.02, 0.5), Eigen::Quaterniond::Identity()),
@@ -222,6 +223,26 @@ TEST(Projection, BlocksGiveWhatEachVertexGetsAlone) {
     EXPECT_EQ(all[k].flags.behind_camera, k == 9) << "vertex " << k;
     EXPECT_EQ(all[k].flags.sigma_point_behind_camera, k == 17) << "vertex " << k;
     EXPECT_EQ(all[k].flags.usable(), k != 9 && k != 17) << "vertex " << k;
+  }
+  // The linear path in the same blocks: J C J^T with the tested Jacobian, under a
+  // covariance that couples every pair of components (so that no term of J can hide).
+  ProjectionOptions linear;
+  linear.method = ProjectionMethod::linear;
+  linear.add_intrinsic_uncertainty = false;
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Mat6 A;
+  for (int i = 0; i < 36; ++i) A(i / 6, i % 6) = u(rng);
+  const Vec6 scale = (Vec6() << 0.01, 0.01, 0.01, 0.03, 0.03, 0.03).finished();
+  const UncertainPose coupled{pose.T, scale.asDiagonal() * (A * A.transpose()) * scale.asDiagonal(), false};
+  const std::vector<ProjectedVertex> first_order = project_vertices(cam, coupled, points, linear);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    EXPECT_EQ(first_order[k].flags.behind_camera, k == 9) << "vertex " << k;
+    if (k == 9) continue;
+    const Mat26 J = pixel_jacobian_wrt_perturbation(cam, coupled.T, points[k]);
+    const Mat2 expected = J * coupled.covariance * J.transpose();
+    EXPECT_LT(relative_frobenius(first_order[k].covariance_px2, expected), 1e-12) << "vertex " << k;
+    EXPECT_LT((first_order[k].mean_px - cam.project(pose.T * points[k])).norm(), 1e-9) << "vertex " << k;
   }
   // And what the plain unscented transform gives, block by block.
   ProjectionOptions o;

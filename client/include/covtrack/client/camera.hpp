@@ -34,6 +34,18 @@ struct Camera {
     u = fx * (x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x)) + cx;
     v = fy * (y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y) + cy;
   }
+  // The same and d(u, v)/d(x, y), row-major, exact (distortion included).
+  void pixel_of_normalised(double x, double y, double& u, double& v, double (&d)[4]) const {
+    pixel_of_normalised(x, y, u, v);
+    const double r2 = x * x + y * y;
+    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double dradial_dr2 = k1 + r2 * (2 * k2 + 3 * k3 * r2);
+    const double drad_dx = 2 * x * dradial_dr2, drad_dy = 2 * y * dradial_dr2;
+    d[0] = fx * (radial + x * drad_dx + 2 * p1 * y + 6 * p2 * x);
+    d[1] = fx * (x * drad_dy + 2 * p1 * x + 2 * p2 * y);
+    d[2] = fy * (y * drad_dx + 2 * p1 * x + 2 * p2 * y);
+    d[3] = fy * (radial + y * drad_dy + 6 * p1 * y + 2 * p2 * x);
+  }
 
   // First-order screen covariance (px^2) due to the intrinsic sigmas, at this point.
   Mat2 intrinsic_covariance(const Vec3& p_camera) const { return intrinsic_covariance_at(project(p_camera)); }
