@@ -280,27 +280,40 @@ void linear_block(const Camera& camera, const Pose& T, const Mat6& covariance,
   }
 }
 
+// Block `first` of the points as structure-of-arrays; a short last block repeats its first
+// point. Returns how many of the block's lanes are real points.
+int load_block(std::span<const Vec3> points, std::size_t first, double (&px)[kBlock],
+               double (&py)[kBlock], double (&pz)[kBlock]) {
+  const int count = static_cast<int>(std::min<std::size_t>(kBlock, points.size() - first));
+  for (int j = 0; j < kBlock; ++j) {
+    const Vec3& p = points[first + (j < count ? j : 0)];
+    px[j] = p.x(), py[j] = p.y(), pz[j] = p.z();
+  }
+  return count;
+}
+
+// The next output vertex at this depth: flagged behind the camera when it has no pixel.
+ProjectedVertex& start_vertex(std::vector<ProjectedVertex>& out, double depth_m,
+                              const ProjectionFlags& shared, const ProjectionOptions& o) {
+  ProjectedVertex& v = out.emplace_back();
+  v.depth_m = depth_m;
+  v.flags = shared;
+  v.flags.behind_camera = depth_m < o.near_m;
+  return v;
+}
+
 void project_linear(const Camera& camera, const UncertainPose& pose,
                     std::span<const Vec3> points, const ProjectionOptions& o,
                     const ProjectionFlags& shared, std::vector<ProjectedVertex>& out) {
   const bool add_intrinsic = o.add_intrinsic_uncertainty && !camera.intrinsic_sigmas_px.isZero();
   LinearBlock b;
   for (std::size_t first = 0; first < points.size(); first += kBlock) {
-    const int count = static_cast<int>(std::min<std::size_t>(kBlock, points.size() - first));
     double px[kBlock], py[kBlock], pz[kBlock];
-    for (int j = 0; j < kBlock; ++j) {
-      const Vec3& p = points[first + (j < count ? j : 0)];
-      px[j] = p.x(), py[j] = p.y(), pz[j] = p.z();
-    }
+    const int count = load_block(points, first, px, py, pz);
     linear_block(camera, pose.T, pose.covariance, px, py, pz, b);
     for (int j = 0; j < count; ++j) {
-      ProjectedVertex& v = out.emplace_back();
-      v.depth_m = b.z[j];
-      v.flags = shared;
-      if (b.z[j] < o.near_m) {
-        v.flags.behind_camera = true;
-        continue;
-      }
+      ProjectedVertex& v = start_vertex(out, b.z[j], shared, o);
+      if (v.flags.behind_camera) continue;
       v.mean_px = Vec2(b.u[j], b.v[j]);
       v.covariance_px2 << b.cuu[j], b.cuv[j], b.cuv[j], b.cvv[j];
       if (add_intrinsic) v.covariance_px2 += camera.intrinsic_covariance_at(v.mean_px);
@@ -315,21 +328,12 @@ void project_unscented(const Camera& camera, const UncertainPose& pose,
   const bool add_intrinsic = o.add_intrinsic_uncertainty && !camera.intrinsic_sigmas_px.isZero();
   UnscentedBlock b;
   for (std::size_t first = 0; first < points.size(); first += kBlock) {
-    const int count = static_cast<int>(std::min<std::size_t>(kBlock, points.size() - first));
     double px[kBlock], py[kBlock], pz[kBlock];
-    for (int j = 0; j < kBlock; ++j) {
-      const Vec3& p = points[first + (j < count ? j : 0)];
-      px[j] = p.x(), py[j] = p.y(), pz[j] = p.z();
-    }
+    const int count = load_block(points, first, px, py, pz);
     unscented_block(camera, sigma, px, py, pz, b);
     for (int j = 0; j < count; ++j) {
-      ProjectedVertex& v = out.emplace_back();
-      v.depth_m = b.z0[j];
-      v.flags = shared;
-      if (b.z0[j] < o.near_m) {
-        v.flags.behind_camera = true;
-        continue;
-      }
+      ProjectedVertex& v = start_vertex(out, b.z0[j], shared, o);
+      if (v.flags.behind_camera) continue;
       v.mean_px = Vec2(b.u0[j], b.v0[j]);
       if (b.zmin[j] < o.near_m) {
         // A pixel from behind the camera would poison the sums: no covariance.
@@ -365,15 +369,9 @@ void project_vertices(const Camera& camera, const UncertainPose& pose,
 
   // LOST: the pixel of the last estimate, no covariance.
   for (const Vec3& p : points) {
-    ProjectedVertex& v = out.emplace_back();
     const Vec3 pc = pose.T * p;
-    v.depth_m = pc.z();
-    v.flags = shared;
-    if (pc.z() < o.near_m) {
-      v.flags.behind_camera = true;
-      continue;
-    }
-    v.mean_px = camera.project(pc);
+    ProjectedVertex& v = start_vertex(out, pc.z(), shared, o);
+    if (!v.flags.behind_camera) v.mean_px = camera.project(pc);
   }
 }
 
