@@ -136,13 +136,11 @@ double edge_blur_px(const cv::Mat& gray, const std::array<cv::Point2d, 4>& c, do
   constexpr double kStep = 0.25;
   std::array<double, 2 * kHalf + 1> profile{};
   std::array<int, 2 * kHalf + 1> count{};
-  const cv::Point2d centre = (c[0] + c[1] + c[2] + c[3]) / 4.0;
+  const auto normal = edge_outward_normals(c);
   for (int e = 0; e < 4; ++e) {
     const cv::Point2d a = c[e], b = c[(e + 1) % 4];
-    const double length = std::hypot(b.x - a.x, b.y - a.y);
-    if (length <= 0) continue;
-    cv::Point2d n((b - a).y / length, -(b - a).x / length);
-    if (n.dot(a - centre) < 0) n = -n;
+    if (std::hypot(b.x - a.x, b.y - a.y) <= 0) continue;
+    const cv::Point2d n = normal[static_cast<std::size_t>(e)];
     for (double f = 0.2; f < 0.81; f += 0.1)
       for (int i = -kHalf; i <= kHalf; ++i) {
         const double g = sample(gray, a + f * (b - a) + n * (i * kStep));
