@@ -62,21 +62,26 @@ class Ellipses {
 
   // Whether every line n_j . x <= h_j holds every ellipse (to rounding). The loop runs over
   // the lines, one ellipse at a time, so that it vectorises (a maximum over the ellipses
-  // would be a reduction, which does not).
+  // would be a reduction, which does not). No square roots: with the room r = h + slack -
+  // n . c left beyond the centre, the support n . c + sqrt(n'Sn) fits iff r >= 0 and
+  // n'Sn <= r^2.
   bool hold_all(std::span<const double> nx, std::span<const double> ny, std::span<const double> h) {
     const std::size_t lines = h.size();
-    excess_.assign(lines, -std::numeric_limits<double>::infinity());
-    double* excess = excess_.data();
+    limit_.resize(lines);
+    worst_.assign(lines, -std::numeric_limits<double>::infinity());
+    double *limit = limit_.data(), *worst = worst_.data();
+    for (std::size_t j = 0; j < lines; ++j) limit[j] = h[j] + 1e-9 * (1 + std::abs(h[j]));
     for (std::size_t i = 0; i < cu_.size(); ++i) {
       const double u = cu_[i], v = cv_[i], xx = sxx_[i], xy = sxy_[i], yy = syy_[i];
       for (std::size_t j = 0; j < lines; ++j) {
         const double x = nx[j], y = ny[j];
-        const double support = x * u + y * v + std::sqrt(std::max(x * x * xx + 2 * x * y * xy + y * y * yy, 0.0));
-        excess[j] = std::max(excess[j], support - h[j]);
+        const double room = limit[j] - (x * u + y * v);
+        const double spread2 = x * x * xx + 2 * x * y * xy + y * y * yy;
+        worst[j] = std::max(worst[j], room < 0 ? 1.0 : spread2 - room * room);
       }
     }
     for (std::size_t j = 0; j < lines; ++j)
-      if (excess[j] > 1e-9 * (1 + std::abs(h[j]))) return false;
+      if (worst[j] > 0) return false;
     return true;
   }
 
@@ -86,15 +91,8 @@ class Ellipses {
            std::sqrt(std::max(n.x() * n.x() * sxx_[i] + 2 * n.x() * n.y() * sxy_[i] + n.y() * n.y() * syy_[i], 0.0));
   }
 
-  // The largest radius of curvature of ellipse i, a^2 / b (semi-axes a >= b); infinite for
-  // a segment, 0 for a point.
-  double largest_curvature_radius(std::size_t i) const {
-    const double mid = 0.5 * (sxx_[i] + syy_[i]), d = 0.5 * (sxx_[i] - syy_[i]);
-    const double half = std::sqrt(d * d + sxy_[i] * sxy_[i]);
-    const double a2 = mid + half, b2 = mid - half;
-    if (!(a2 > 0)) return 0;
-    return b2 > 0 ? a2 / std::sqrt(b2) : std::numeric_limits<double>::infinity();
-  }
+  // Ellipse i's shape: xx, xy, yy.
+  Vec3 shape(std::size_t i) const { return {sxx_[i], sxy_[i], syy_[i]}; }
 
   // The point of ellipse i farthest along n (any length): c + S n / sqrt(n^T S n).
   Vec2 farthest_point(std::size_t i, const Vec2& n) const {
@@ -106,7 +104,7 @@ class Ellipses {
 
  private:
   static constexpr std::size_t kBlock = 8;
-  std::vector<double> cu_, cv_, sxx_, sxy_, syy_, h_, excess_;
+  std::vector<double> cu_, cv_, sxx_, sxy_, syy_, h_, limit_, worst_;
 };
 
 double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
@@ -146,14 +144,54 @@ struct ArcLine {
   std::size_t ellipse;  // of the arc this line starts or lies in
 };
 
-// An upper bound of the angle from unit a to unit b (counter-clockwise, less than pi),
-// without trigonometry: theta = 2 atan(x), x = cross / (1 + dot), and atan(x) is within
-// 0.005 rad of x / (1 + 0.28125 x^2) for |x| <= 1 (of pi/2 - the same at 1/x beyond).
-double angle_upper_bound(const Vec2& a, const Vec2& b) {
-  const double x = cross(a, b) / (1 + a.dot(b));
-  const double half = x <= 1 ? x / (1 + 0.28125 * x * x)
-                             : std::numbers::pi / 2 - (1 / x) / (1 + 0.28125 / (x * x));
-  return 2 * (half + 0.005);
+// How many times each arc's angle is halved (see expand_by_arcs): arc i runs from the
+// normal of tangents[i] to that of the next, on tangents[i]'s ellipse. All arcs side by side,
+// in a loop that vectorises: each count is a chain of square roots and divisions that would
+// leave the processor waiting, arc after arc. False where an arc turns clockwise or by about
+// pi, or needs more than `most` halvings (a sharp or degenerate ellipse).
+bool arc_halvings(const Ellipses& ellipses, std::span<const ArcLine> tangents, double tol, int most,
+                  std::vector<int>& halvings) {
+  const std::size_t k = tangents.size();
+  thread_local std::vector<double> sx, sy, ex, ey, xx, xy, yy, ratio;
+  for (auto* column : {&sx, &sy, &ex, &ey, &xx, &xy, &yy, &ratio}) column->resize(k);
+  for (std::size_t i = 0; i < k; ++i) {
+    const Vec2& start = tangents[i].normal;
+    const Vec2& end = tangents[i + 1 == k ? 0 : i + 1].normal;
+    const Vec3 S = ellipses.shape(tangents[i].ellipse);
+    sx[i] = start.x(), sy[i] = start.y(), ex[i] = end.x(), ey[i] = end.y();
+    xx[i] = S[0], xy[i] = S[1], yy[i] = S[2];
+  }
+  constexpr double pi = std::numbers::pi, inf = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < k; ++i) {
+    // An upper bound of the arc's angle, without trigonometry: theta = 2 atan(x),
+    // x = cross / (1 + dot), and atan(x) is within 0.005 rad of x / (1 + 0.28125 x^2) for
+    // |x| <= 1 (of pi/2 - x / (x^2 + 0.28125) beyond).
+    const double cross = sx[i] * ey[i] - sy[i] * ex[i], dot = sx[i] * ex[i] + sy[i] * ey[i];
+    const double x = cross / (1 + dot);
+    const double half = x <= 1 ? x / (1 + 0.28125 * x * x) : pi / 2 - x / (x * x + 0.28125);
+    const double angle2 = 4 * (half + 0.005) * (half + 0.005);
+    // ratio = (angle / step)^2, with step the widest gap whose corner stays within tol of a
+    // circle of the ellipse's largest radius of curvature rho = a^2 / b (semi-axes a >= b):
+    // (step / 2)^2 = 2r / (1 + r), r = tol / rho, so ratio = angle^2 (rho + tol) / (8 tol).
+    // A point (rho = 0) takes any gap below pi, a segment (rho infinite) none.
+    const double mid = 0.5 * (xx[i] + yy[i]), d = 0.5 * (xx[i] - yy[i]);
+    const double spread = std::sqrt(d * d + xy[i] * xy[i]);
+    const double a2 = mid + spread, b2 = std::max(mid - spread, 0.0);
+    const double rho = a2 / std::sqrt(b2);
+    const bool turns = (cross > 1e-9) & (dot >= -0.99);
+    const double arc_ratio = a2 > 0 ? angle2 * (rho + tol) / (8 * tol) : angle2 / (pi * pi);
+    ratio[i] = turns ? arc_ratio : inf;
+  }
+  // The fewest halvings h with ratio <= 4^h.
+  halvings.resize(k);
+  for (std::size_t i = 0; i < k; ++i) {
+    int h = 0;
+    double power = 1;  // 4^h
+    for (; h <= most && !(ratio[i] <= power); ++h) power *= 4;
+    if (h > most) return false;
+    halvings[i] = h;
+  }
+  return true;
 }
 
 // The shortcut. Usually the boundary of the ellipses' hull is an arc of each mean hull
@@ -192,23 +230,15 @@ bool expand_by_arcs(Ellipses& ellipses, std::span<const ProjectedVertex> vertice
     }
   }
 
+  thread_local std::vector<int> halvings;
+  if (!arc_halvings(ellipses, tangents, tol, kMostHalvings, halvings)) return false;
   lines.clear();
   for (std::size_t i = 0; i < k; ++i) {
     const ArcLine& start = tangents[i];
     const Vec2& end = tangents[(i + 1) % k].normal;
-    // An arc turns counter-clockwise by less than pi; otherwise its ellipse is not on the
-    // boundary as assumed.
-    if (!(cross(start.normal, end) > 1e-9) || start.normal.dot(end) < -0.99) return false;
-    const double rho = ellipses.largest_curvature_radius(start.ellipse);
-    const double r = tol / rho;
-    const double step = rho > 0 ? 2 * std::sqrt(2 * r / (1 + r)) : std::numbers::pi;
-    const double angle = angle_upper_bound(start.normal, end);
-    int halvings = 0;
-    while (angle > step * (1 << halvings))
-      if (++halvings > kMostHalvings) return false;
     lines.push_back(start);
     // Directions by halving: normalised sums of neighbours, uniform in angle.
-    const int n = 1 << halvings;
+    const int n = 1 << halvings[i];
     Vec2 dirs[(1 << kMostHalvings) + 1];
     dirs[0] = start.normal, dirs[n] = end;
     for (int gap = n; gap > 1; gap /= 2)

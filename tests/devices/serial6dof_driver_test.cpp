@@ -211,8 +211,9 @@ TEST(Serial6dofDriver, UnpluggedPortGivesLostWithinTwoPeriodsThenRecovers) {
   rig.emulator->replug();
   while (!rig.emulator->plugged()) std::this_thread::sleep_for(5ms);
   test::CaptureSink after;
-  EXPECT_TRUE(run_for_samples(after, c, 100, 1));
-  EXPECT_GE(nees(after, rig).n, 100);
+  const Result<void> back = run_for_samples(after, c, 100, 1);
+  EXPECT_TRUE(back) << back.error().message;
+  EXPECT_GE(nees(after, rig).n, 100) << "errors: " << after.errors;
   EXPECT_GE(rig.emulator->resets(), 1u);
 }
 

@@ -97,10 +97,13 @@ class Emulator::Impl {
     if (e.want_plugged_ != pty_.plugged()) {
       if (e.want_plugged_) {
         if (pty_.replug()) unit_->power_on();  // a replugged unit starts from power-up
+        e.plugged_ = pty_.plugged();
       } else {
+        // Cleared before the hang-up: a test that sees the driver fail and then waits for
+        // plugged() after replug() must not see this stale "plugged" and race the new link.
+        e.plugged_ = false;
         pty_.unplug();
       }
-      e.plugged_ = pty_.plugged();
     }
     return pty_.plugged();
   }
