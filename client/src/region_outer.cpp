@@ -85,12 +85,8 @@ class Ellipses {
     return true;
   }
 
-  // The support of ellipse i alone along unit n.
-  double support_of(std::size_t i, const Vec2& n) const {
-    return n.x() * cu_[i] + n.y() * cv_[i] +
-           std::sqrt(std::max(n.x() * n.x() * sxx_[i] + 2 * n.x() * n.y() * sxy_[i] + n.y() * n.y() * syy_[i], 0.0));
-  }
-
+  // Ellipse i's centre.
+  Vec2 centre(std::size_t i) const { return {cu_[i], cv_[i]}; }
   // Ellipse i's shape: xx, xy, yy.
   Vec3 shape(std::size_t i) const { return {sxx_[i], sxy_[i], syy_[i]}; }
 
@@ -108,12 +104,6 @@ class Ellipses {
 };
 
 double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-// Where two lines n . x = h (normals less than pi apart) cross.
-Vec2 corner(const Vec2& na, double ha, const Vec2& nb, double hb) {
-  const double inverse_det = 1 / cross(na, nb);
-  return inverse_det * Vec2(ha * nb.y() - hb * na.y(), hb * na.x() - ha * nb.x());
-}
 
 // The direction to split the gap between lines a and b: the normal of the chord between
 // their contact points. When the contacts are on two different ellipses it converges to
@@ -144,52 +134,120 @@ struct ArcLine {
   std::size_t ellipse;  // of the arc this line starts or lies in
 };
 
+// The shortcut's lines as structure-of-arrays, each with the ellipse of its arc (centre u,
+// v; shape xx, xy, yy): their supports and their corners' checks are loops over all lines
+// that vectorise, where line after line would wait on a square root and two divisions each.
+// Fixed arrays, so the compiler sees that they do not overlap; an object needing more lines
+// goes to the search. Line size() repeats line 0: corner p (of lines p and p + 1) needs no
+// wrap-around.
+struct ShortcutLines {
+  static constexpr std::size_t kMost = 64;
+  double nx[kMost + 1], ny[kMost + 1], h[kMost + 1], u[kMost], v[kMost], xx[kMost], xy[kMost],
+      yy[kMost], qx[kMost], qy[kMost], gap2[kMost];
+  std::size_t count = 0;
+
+  std::size_t size() const { return count; }
+  // offset = -infinity: the line is a support of its own ellipse (see close_with_supports).
+  // False when full.
+  bool push(const Ellipses& ellipses, const Vec2& normal, double offset, std::size_t ellipse) {
+    if (count == kMost) return false;
+    const Vec3 S = ellipses.shape(ellipse);
+    const Vec2 c = ellipses.centre(ellipse);
+    nx[count] = normal.x(), ny[count] = normal.y(), h[count] = offset;
+    u[count] = c.x(), v[count] = c.y(), xx[count] = S[0], xy[count] = S[1], yy[count] = S[2];
+    ++count;
+    return true;
+  }
+};
+
+// Fills the supports (a given offset, a common tangent's, is already the larger of two
+// ellipses' supports, so the maximum keeps it) and closes the cycle.
+COVTRACK_VECTOR_CLONES
+void close_with_supports(ShortcutLines& lines) {
+  const std::size_t n = lines.count;
+  for (std::size_t p = 0; p < n; ++p) {
+    const double x = lines.nx[p], y = lines.ny[p];
+    const double support = x * lines.u[p] + y * lines.v[p] + std::sqrt(std::max(x * x * lines.xx[p] + 2 * x * y * lines.xy[p] + y * y * lines.yy[p], 0.0));
+    lines.h[p] = std::max(lines.h[p], support);
+  }
+  lines.nx[n] = lines.nx[0], lines.ny[n] = lines.ny[0], lines.h[n] = lines.h[0];
+}
+
+// Corner p of lines p and p + 1, and whether each lies within tol of the point of line
+// p's ellipse facing it (the farthest along n_p + n_p+1), as in the search. (The squared
+// distances go to an array checked after the loop: a running maximum would be a
+// reduction, which does not vectorise.)
+COVTRACK_VECTOR_CLONES
+bool corners_within(ShortcutLines& lines, double tol) {
+  const std::size_t n = lines.count;
+  for (std::size_t p = 0; p < n; ++p) {
+    const double ax = lines.nx[p], ay = lines.ny[p], bx = lines.nx[p + 1], by = lines.ny[p + 1];
+    const double inverse_det = 1 / (ax * by - ay * bx);
+    const double cx = inverse_det * (lines.h[p] * by - lines.h[p + 1] * ay), cy = inverse_det * (lines.h[p + 1] * ax - lines.h[p] * bx);
+    const double mx = ax + bx, my = ay + by;
+    const double sx = lines.xx[p] * mx + lines.xy[p] * my, sy = lines.xy[p] * mx + lines.yy[p] * my;
+    const double r2 = mx * sx + my * sy;
+    const double inverse_r = r2 > 0 ? 1 / std::sqrt(r2) : 0.0;  // a point: its centre
+    const double dx = cx - (lines.u[p] + sx * inverse_r), dy = cy - (lines.v[p] + sy * inverse_r);
+    lines.gap2[p] = dx * dx + dy * dy;
+    lines.qx[p] = cx, lines.qy[p] = cy;
+  }
+  for (std::size_t p = 0; p < n; ++p)
+    if (!(lines.gap2[p] <= tol * tol)) return false;
+  return true;
+}
+
 // How many times each arc's angle is halved (see expand_by_arcs): arc i runs from the
-// normal of tangents[i] to that of the next, on tangents[i]'s ellipse. All arcs side by side,
-// in a loop that vectorises: each count is a chain of square roots and divisions that would
-// leave the processor waiting, arc after arc. False where an arc turns clockwise or by about
-// pi, or needs more than `most` halvings (a sharp or degenerate ellipse).
+// normal of tangents[i] to that of the next, on tangents[i]'s ellipse. Blocks of arcs side
+// by side, in loops of fixed length that vectorise: each count is a chain of square roots
+// and divisions that would leave the processor waiting, arc after arc. False where an arc
+// turns clockwise or by about pi, or needs more than `most` halvings (a sharp or
+// degenerate ellipse).
 bool arc_halvings(const Ellipses& ellipses, std::span<const ArcLine> tangents, double tol, int most,
                   std::vector<int>& halvings) {
-  const std::size_t k = tangents.size();
-  thread_local std::vector<double> sx, sy, ex, ey, xx, xy, yy, ratio;
-  for (auto* column : {&sx, &sy, &ex, &ey, &xx, &xy, &yy, &ratio}) column->resize(k);
-  for (std::size_t i = 0; i < k; ++i) {
-    const Vec2& start = tangents[i].normal;
-    const Vec2& end = tangents[i + 1 == k ? 0 : i + 1].normal;
-    const Vec3 S = ellipses.shape(tangents[i].ellipse);
-    sx[i] = start.x(), sy[i] = start.y(), ex[i] = end.x(), ey[i] = end.y();
-    xx[i] = S[0], xy[i] = S[1], yy[i] = S[2];
-  }
+  constexpr int kArcs = 8;  // per block; a short last block repeats its first arc
   constexpr double pi = std::numbers::pi, inf = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < k; ++i) {
-    // An upper bound of the arc's angle, without trigonometry: theta = 2 atan(x),
-    // x = cross / (1 + dot), and atan(x) is within 0.005 rad of x / (1 + 0.28125 x^2) for
-    // |x| <= 1 (of pi/2 - x / (x^2 + 0.28125) beyond).
-    const double cross = sx[i] * ey[i] - sy[i] * ex[i], dot = sx[i] * ex[i] + sy[i] * ey[i];
-    const double x = cross / (1 + dot);
-    const double half = x <= 1 ? x / (1 + 0.28125 * x * x) : pi / 2 - x / (x * x + 0.28125);
-    const double angle2 = 4 * (half + 0.005) * (half + 0.005);
-    // ratio = (angle / step)^2, with step the widest gap whose corner stays within tol of a
-    // circle of the ellipse's largest radius of curvature rho = a^2 / b (semi-axes a >= b):
-    // (step / 2)^2 = 2r / (1 + r), r = tol / rho, so ratio = angle^2 (rho + tol) / (8 tol).
-    // A point (rho = 0) takes any gap below pi, a segment (rho infinite) none.
-    const double mid = 0.5 * (xx[i] + yy[i]), d = 0.5 * (xx[i] - yy[i]);
-    const double spread = std::sqrt(d * d + xy[i] * xy[i]);
-    const double a2 = mid + spread, b2 = std::max(mid - spread, 0.0);
-    const double rho = a2 / std::sqrt(b2);
-    const bool turns = (cross > 1e-9) & (dot >= -0.99);
-    const double arc_ratio = a2 > 0 ? angle2 * (rho + tol) / (8 * tol) : angle2 / (pi * pi);
-    ratio[i] = turns ? arc_ratio : inf;
-  }
-  // The fewest halvings h with ratio <= 4^h.
+  const std::size_t k = tangents.size();
   halvings.resize(k);
-  for (std::size_t i = 0; i < k; ++i) {
-    int h = 0;
-    double power = 1;  // 4^h
-    for (; h <= most && !(ratio[i] <= power); ++h) power *= 4;
-    if (h > most) return false;
-    halvings[i] = h;
+  for (std::size_t first = 0; first < k; first += kArcs) {
+    const int count = static_cast<int>(std::min<std::size_t>(kArcs, k - first));
+    double sx[kArcs], sy[kArcs], ex[kArcs], ey[kArcs], xx[kArcs], xy[kArcs], yy[kArcs], ratio[kArcs];
+    for (int j = 0; j < kArcs; ++j) {
+      const std::size_t i = first + (j < count ? j : 0);
+      const Vec2& start = tangents[i].normal;
+      const Vec2& end = tangents[i + 1 == k ? 0 : i + 1].normal;
+      const Vec3 S = ellipses.shape(tangents[i].ellipse);
+      sx[j] = start.x(), sy[j] = start.y(), ex[j] = end.x(), ey[j] = end.y();
+      xx[j] = S[0], xy[j] = S[1], yy[j] = S[2];
+    }
+    for (int j = 0; j < kArcs; ++j) {
+      // An upper bound of the arc's angle, without trigonometry: theta = 2 atan(x),
+      // x = cross / (1 + dot), and atan(x) is within 0.005 rad of x / (1 + 0.28125 x^2) for
+      // |x| <= 1 (of pi/2 - x / (x^2 + 0.28125) beyond).
+      const double cross = sx[j] * ey[j] - sy[j] * ex[j], dot = sx[j] * ex[j] + sy[j] * ey[j];
+      const double x = cross / (1 + dot);
+      const double half = x <= 1 ? x / (1 + 0.28125 * x * x) : pi / 2 - x / (x * x + 0.28125);
+      const double angle2 = 4 * (half + 0.005) * (half + 0.005);
+      // ratio = (angle / step)^2, with step the widest gap whose corner stays within tol of
+      // a circle of the ellipse's largest radius of curvature rho = a^2 / b (semi-axes
+      // a >= b): (step / 2)^2 = 2r / (1 + r), r = tol / rho, so ratio = angle^2 (rho + tol) /
+      // (8 tol). A point (rho = 0) takes any gap below pi, a segment (rho infinite) none.
+      const double mid = 0.5 * (xx[j] + yy[j]), d = 0.5 * (xx[j] - yy[j]);
+      const double spread = std::sqrt(d * d + xy[j] * xy[j]);
+      const double a2 = mid + spread, b2 = std::max(mid - spread, 0.0);
+      const double rho = a2 / std::sqrt(b2);
+      const bool turns = (cross > 1e-9) & (dot >= -0.99);
+      const double arc_ratio = a2 > 0 ? angle2 * (rho + tol) / (8 * tol) : angle2 / (pi * pi);
+      ratio[j] = turns ? arc_ratio : inf;
+    }
+    // The fewest halvings h with ratio <= 4^h.
+    for (int j = 0; j < count; ++j) {
+      int h = 0;
+      double power = 1;  // 4^h
+      for (; h <= most && !(ratio[j] <= power); ++h) power *= 4;
+      if (h > most) return false;
+      halvings[first + j] = h;
+    }
   }
   return true;
 }
@@ -212,7 +270,7 @@ bool expand_by_arcs(Ellipses& ellipses, std::span<const ProjectedVertex> vertice
   const double tol = o.max_polygon_error_px;
 
   // The tangent of hull edge i (hull[i] -> hull[i + 1]) starts the arc of ellipse hull[i + 1].
-  thread_local std::vector<ArcLine> tangents, lines;
+  thread_local std::vector<ArcLine> tangents;
   tangents.resize(k);
   TangentBlock block;
   for (std::size_t first = 0; first < k; first += kTangentPairs) {
@@ -232,11 +290,13 @@ bool expand_by_arcs(Ellipses& ellipses, std::span<const ProjectedVertex> vertice
 
   thread_local std::vector<int> halvings;
   if (!arc_halvings(ellipses, tangents, tol, kMostHalvings, halvings)) return false;
-  lines.clear();
+  thread_local ShortcutLines lines;
+  lines.count = 0;
+  constexpr double kUnknown = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < k; ++i) {
     const ArcLine& start = tangents[i];
     const Vec2& end = tangents[(i + 1) % k].normal;
-    lines.push_back(start);
+    if (!lines.push(ellipses, start.normal, start.offset, start.ellipse)) return false;
     // Directions by halving: normalised sums of neighbours, uniform in angle.
     const int n = 1 << halvings[i];
     Vec2 dirs[(1 << kMostHalvings) + 1];
@@ -244,25 +304,18 @@ bool expand_by_arcs(Ellipses& ellipses, std::span<const ProjectedVertex> vertice
     for (int gap = n; gap > 1; gap /= 2)
       for (int j = gap / 2; j < n; j += gap) dirs[j] = (dirs[j - gap / 2] + dirs[j + gap / 2]).normalized();
     for (int j = 1; j < n; ++j)
-      lines.push_back({dirs[j], ellipses.support_of(start.ellipse, dirs[j]), start.ellipse});
+      if (!lines.push(ellipses, dirs[j], kUnknown, start.ellipse)) return false;
     if (static_cast<int>(lines.size()) > o.max_outer_corners) return false;
   }
-
-  // Every line a support of the whole set (to rounding).
-  thread_local std::vector<double> nx, ny, h;
-  nx.clear(), ny.clear(), h.clear();
-  for (const ArcLine& line : lines)
-    nx.push_back(line.normal.x()), ny.push_back(line.normal.y()), h.push_back(line.offset);
+  close_with_supports(lines);
+  // Every line a support of the whole set (to rounding), every corner within the tolerance
+  // of its arc's ellipse.
+  const std::span<const double> nx(lines.nx, lines.size()), ny(lines.ny, lines.size()), h(lines.h, lines.size());
   if (!ellipses.hold_all(nx, ny, h)) return false;
-  // Every corner within the tolerance of the arc's ellipse.
-  const double tolerance2 = tol * tol;
+  if (!corners_within(lines, tol)) return false;
   outer.clear();
   for (std::size_t p = 0; p < lines.size(); ++p) {
-    const ArcLine& a = lines[p];
-    const ArcLine& b = lines[p + 1 == lines.size() ? 0 : p + 1];
-    const Vec2 q = corner(a.normal, a.offset, b.normal, b.offset);
-    if ((q - ellipses.farthest_point(a.ellipse, a.normal + b.normal)).squaredNorm() > tolerance2)
-      return false;
+    const Vec2 q(lines.qx[p], lines.qy[p]);
     if (outer.empty() || (q - outer.back()).squaredNorm() > 1e-18) outer.push_back(q);
   }
   while (outer.size() > 1 && (outer.front() - outer.back()).squaredNorm() <= 1e-18) outer.pop_back();

@@ -31,4 +31,10 @@ void set_tangent_pair(TangentBlock& block, int j, const ProjectedVertex& a,
 // larger of their supports, so the half-plane holds both.
 void common_tangents(TangentBlock& block, TangentSide side);
 
+// Where two lines n . x = h (normals less than pi apart) cross: the corners of both regions.
+inline Vec2 corner(const Vec2& na, double ha, const Vec2& nb, double hb) {
+  const double inverse_det = 1 / (na.x() * nb.y() - na.y() * nb.x());
+  return inverse_det * Vec2(ha * nb.y() - hb * na.y(), hb * na.x() - ha * nb.x());
+}
+
 }  // namespace covtrack::client

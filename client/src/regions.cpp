@@ -7,16 +7,38 @@
 
 namespace covtrack::client {
 
-void contract_region(std::span<const ProjectedVertex> hull, const RegionOptions& o,
-                     Polygon& inner) {
-  inner.clear();
-  const std::size_t k = hull.size();
-  if (k < 3) return;  // a point or a segment has no interior to keep
-  const double s2 = std::pow(confidence_scale(o.confidence), 2);
+namespace {
 
-  // Start from a box well around the hull; the half-planes cut it down. Each cut adds at
-  // most one corner, so two buffers of 4 + k corners hold every step (kept per thread: no
-  // allocation per object).
+// The region when it is the polygon of consecutive lines' corners: each line's normal turns
+// left of the one before by less than pi (so, in all, once round) and each line keeps an
+// edge of positive length between its corners with the lines before and after. Then that
+// polygon is convex with an edge on every line, so it is their intersection, found without
+// clipping. False otherwise (an empty or degenerate region, or a line that cuts off no
+// edge): the caller clips.
+bool corners_of_consecutive_lines(std::span<const Vec2> normals, std::span<const double> offsets,
+                                  Polygon& region) {
+  const std::size_t k = normals.size();
+  region.resize(k);
+  for (std::size_t i = 0; i < k; ++i) {
+    const std::size_t next = i + 1 == k ? 0 : i + 1;
+    const Vec2 &a = normals[i], &b = normals[next];
+    if (!(a.x() * b.y() - a.y() * b.x() > 0)) return false;
+    region[i] = corner(a, offsets[i], b, offsets[next]);  // line i's end, line next's start
+  }
+  for (std::size_t i = 0; i < k; ++i) {
+    const Vec2& n = normals[i];
+    const Vec2 edge = region[i] - region[i == 0 ? k - 1 : i - 1];
+    if (!(n.x() * edge.y() - n.y() * edge.x() > 0)) return false;  // along (-n_y, n_x)
+  }
+  return true;
+}
+
+// The general way: a box well around the hull, cut down by each half-plane in turn. Each
+// cut adds at most one corner, so two buffers of 4 + k corners hold every step (kept per
+// thread: no allocation per object).
+void clip_box(std::span<const ProjectedVertex> hull, std::span<const Vec2> normals,
+              std::span<const double> offsets, Polygon& inner) {
+  const std::size_t k = normals.size();
   Eigen::AlignedBox2d box;
   for (const ProjectedVertex& v : hull) box.extend(v.mean_px);
   const double margin = box.diagonal().norm() + 1.0;
@@ -29,25 +51,42 @@ void contract_region(std::span<const ProjectedVertex> hull, const RegionOptions&
   region[2] = box.max() + Vec2(margin, margin);
   region[3] = Vec2(box.min().x() - margin, box.max().y() + margin);
   std::size_t size = 4;
+  for (std::size_t i = 0; i < k && size > 0; ++i) {
+    size = clip_half_plane(std::span<const Vec2>(region, size), normals[i], offsets[i], next);
+    std::swap(region, next);
+  }
+  inner.assign(region, region + size);
+}
+
+}  // namespace
+
+void contract_region(std::span<const ProjectedVertex> hull, const RegionOptions& o,
+                     Polygon& inner) {
+  inner.clear();
+  const std::size_t k = hull.size();
+  if (k < 3) return;  // a point or a segment has no interior to keep
+  const double s2 = std::pow(confidence_scale(o.confidence), 2);
+
   // One line per hull edge, tangent to the ellipses at its ends (region_tangents.hpp).
+  thread_local std::vector<Vec2> normals;
+  thread_local std::vector<double> offsets;
+  normals.clear(), offsets.clear();
   TangentBlock block;
-  for (std::size_t first = 0; first < k && size > 0; first += kTangentPairs) {
+  for (std::size_t first = 0; first < k; first += kTangentPairs) {
     const int count = static_cast<int>(std::min<std::size_t>(kTangentPairs, k - first));
     for (int j = 0; j < kTangentPairs; ++j) {  // a short block repeats its first edge
       const std::size_t i = first + (j < count ? j : 0);
       set_tangent_pair(block, j, hull[i], hull[(i + 1) % k], s2);
     }
     common_tangents(block, TangentSide::inner);
-    for (int j = 0; j < count && size > 0; ++j) {
-      size = clip_half_plane(std::span<const Vec2>(region, size), Vec2(block.nu[j], block.nv[j]),
-                             block.offset[j], next);
-      std::swap(region, next);
+    for (int j = 0; j < count; ++j) {
+      normals.emplace_back(block.nu[j], block.nv[j]);
+      offsets.push_back(block.offset[j]);
     }
   }
+  if (!corners_of_consecutive_lines(normals, offsets, inner)) clip_box(hull, normals, offsets, inner);
   // A sliver left by rounding is no region.
-  if (size < 3) return;
-  inner.assign(region, region + size);
-  if (polygon_area(inner) <= 1e-9) inner.clear();
+  if (inner.size() < 3 || polygon_area(inner) <= 1e-9) inner.clear();
 }
 
 Polygon contract_region(std::span<const ProjectedVertex> hull, const RegionOptions& o) {

@@ -24,8 +24,10 @@
 //    line tangent to both adjacent ellipses on the interior side; the region is the
 //    intersection of the interior half-planes. Where the seed's construction (corners =
 //    intersections of consecutive tangent lines, then their hull) is well formed, the two
-//    are the same polygon; the half-plane form stays right when tangent lines become
-//    redundant or cross, and is empty when the errors swamp the object. Each tangent is
+//    are the same polygon, and it is used when checks show that (each line turns left of
+//    the last by less than pi and keeps an edge of positive length); otherwise the
+//    half-planes clip a box, which stays right when tangent lines become redundant or
+//    cross, and is empty when the errors swamp the object. Each tangent is
 //    solved by Newton's method until the two ellipses' supports agree to 1e-7 px, or for
 //    one last step from 1e-3 px (quadratic convergence lands far closer; a test checks
 //    1e-5 px); the line is then moved to the smaller support, so what is left of that
