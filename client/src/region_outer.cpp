@@ -103,8 +103,6 @@ class Ellipses {
   std::vector<double> cu_, cv_, sxx_, sxy_, syy_, h_, limit_, worst_;
 };
 
-double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
 // The direction to split the gap between lines a and b: the normal of the chord between
 // their contact points. When the contacts are on two different ellipses it converges to
 // their common tangent at once (exactly, for points), where bisecting would only creep up
@@ -176,7 +174,8 @@ void close_with_supports(ShortcutLines& lines) {
 // Corner p of lines p and p + 1, and whether each lies within tol of the point of line
 // p's ellipse facing it (the farthest along n_p + n_p+1), as in the search. (The squared
 // distances go to an array checked after the loop: a running maximum would be a
-// reduction, which does not vectorise.)
+// reduction, which does not vectorise. corner() and Ellipses::farthest_point are written
+// out in scalars here: through Eigen's Vec2 the loop does not vectorise.)
 COVTRACK_VECTOR_CLONES
 bool corners_within(ShortcutLines& lines, double tol) {
   const std::size_t n = lines.count;
@@ -270,22 +269,14 @@ bool expand_by_arcs(Ellipses& ellipses, std::span<const ProjectedVertex> vertice
   const double tol = o.max_polygon_error_px;
 
   // The tangent of hull edge i (hull[i] -> hull[i + 1]) starts the arc of ellipse hull[i + 1].
+  thread_local std::vector<TangentLine> solved;
   thread_local std::vector<ArcLine> tangents;
+  hull_tangents(k, [&](std::size_t i) -> const ProjectedVertex& { return vertices[hull[i]]; }, s2,
+                TangentSide::outer, solved);
   tangents.resize(k);
-  TangentBlock block;
-  for (std::size_t first = 0; first < k; first += kTangentPairs) {
-    const int count = static_cast<int>(std::min<std::size_t>(kTangentPairs, k - first));
-    for (int j = 0; j < kTangentPairs; ++j) {  // a short block repeats its first edge
-      const std::size_t i = first + (j < count ? j : 0);
-      set_tangent_pair(block, j, vertices[hull[i]], vertices[hull[(i + 1) % k]], s2);
-    }
-    common_tangents(block, TangentSide::outer);
-    for (int j = 0; j < count; ++j) {
-      if (block.solved[j] == 0) return false;
-      const std::size_t i = first + j;
-      tangents[i] = {Vec2(block.nu[j], block.nv[j]), block.offset[j],
-                     static_cast<std::size_t>(hull[(i + 1) % k])};
-    }
+  for (std::size_t i = 0; i < k; ++i) {
+    if (!solved[i].solved) return false;
+    tangents[i] = {solved[i].normal, solved[i].offset, static_cast<std::size_t>(hull[(i + 1) % k])};
   }
 
   thread_local std::vector<int> halvings;

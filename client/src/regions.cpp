@@ -15,20 +15,17 @@ namespace {
 // polygon is convex with an edge on every line, so it is their intersection, found without
 // clipping. False otherwise (an empty or degenerate region, or a line that cuts off no
 // edge): the caller clips.
-bool corners_of_consecutive_lines(std::span<const Vec2> normals, std::span<const double> offsets,
-                                  Polygon& region) {
-  const std::size_t k = normals.size();
+bool corners_of_consecutive_lines(std::span<const TangentLine> lines, Polygon& region) {
+  const std::size_t k = lines.size();
   region.resize(k);
   for (std::size_t i = 0; i < k; ++i) {
-    const std::size_t next = i + 1 == k ? 0 : i + 1;
-    const Vec2 &a = normals[i], &b = normals[next];
-    if (!(a.x() * b.y() - a.y() * b.x() > 0)) return false;
-    region[i] = corner(a, offsets[i], b, offsets[next]);  // line i's end, line next's start
+    const TangentLine &a = lines[i], &b = lines[i + 1 == k ? 0 : i + 1];
+    if (!(cross(a.normal, b.normal) > 0)) return false;
+    region[i] = corner(a.normal, a.offset, b.normal, b.offset);  // line i's end, the next one's start
   }
   for (std::size_t i = 0; i < k; ++i) {
-    const Vec2& n = normals[i];
     const Vec2 edge = region[i] - region[i == 0 ? k - 1 : i - 1];
-    if (!(n.x() * edge.y() - n.y() * edge.x() > 0)) return false;  // along (-n_y, n_x)
+    if (!(cross(lines[i].normal, edge) > 0)) return false;  // along (-n_y, n_x)
   }
   return true;
 }
@@ -36,9 +33,9 @@ bool corners_of_consecutive_lines(std::span<const Vec2> normals, std::span<const
 // The general way: a box well around the hull, cut down by each half-plane in turn. Each
 // cut adds at most one corner, so two buffers of 4 + k corners hold every step (kept per
 // thread: no allocation per object).
-void clip_box(std::span<const ProjectedVertex> hull, std::span<const Vec2> normals,
-              std::span<const double> offsets, Polygon& inner) {
-  const std::size_t k = normals.size();
+void clip_box(std::span<const ProjectedVertex> hull, std::span<const TangentLine> lines,
+              Polygon& inner) {
+  const std::size_t k = lines.size();
   Eigen::AlignedBox2d box;
   for (const ProjectedVertex& v : hull) box.extend(v.mean_px);
   const double margin = box.diagonal().norm() + 1.0;
@@ -52,7 +49,7 @@ void clip_box(std::span<const ProjectedVertex> hull, std::span<const Vec2> norma
   region[3] = Vec2(box.min().x() - margin, box.max().y() + margin);
   std::size_t size = 4;
   for (std::size_t i = 0; i < k && size > 0; ++i) {
-    size = clip_half_plane(std::span<const Vec2>(region, size), normals[i], offsets[i], next);
+    size = clip_half_plane(std::span<const Vec2>(region, size), lines[i].normal, lines[i].offset, next);
     std::swap(region, next);
   }
   inner.assign(region, region + size);
@@ -68,23 +65,9 @@ void contract_region(std::span<const ProjectedVertex> hull, const RegionOptions&
   const double s2 = std::pow(confidence_scale(o.confidence), 2);
 
   // One line per hull edge, tangent to the ellipses at its ends (region_tangents.hpp).
-  thread_local std::vector<Vec2> normals;
-  thread_local std::vector<double> offsets;
-  normals.clear(), offsets.clear();
-  TangentBlock block;
-  for (std::size_t first = 0; first < k; first += kTangentPairs) {
-    const int count = static_cast<int>(std::min<std::size_t>(kTangentPairs, k - first));
-    for (int j = 0; j < kTangentPairs; ++j) {  // a short block repeats its first edge
-      const std::size_t i = first + (j < count ? j : 0);
-      set_tangent_pair(block, j, hull[i], hull[(i + 1) % k], s2);
-    }
-    common_tangents(block, TangentSide::inner);
-    for (int j = 0; j < count; ++j) {
-      normals.emplace_back(block.nu[j], block.nv[j]);
-      offsets.push_back(block.offset[j]);
-    }
-  }
-  if (!corners_of_consecutive_lines(normals, offsets, inner)) clip_box(hull, normals, offsets, inner);
+  thread_local std::vector<TangentLine> lines;
+  hull_tangents(k, [&](std::size_t i) -> const ProjectedVertex& { return hull[i]; }, s2, TangentSide::inner, lines);
+  if (!corners_of_consecutive_lines(lines, inner)) clip_box(hull, lines, inner);
   // A sliver left by rounding is no region.
   if (inner.size() < 3 || polygon_area(inner) <= 1e-9) inner.clear();
 }
