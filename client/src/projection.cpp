@@ -1,7 +1,6 @@
 #include "covtrack/client/projection.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 #include <Eigen/Eigenvalues>
@@ -34,21 +33,11 @@ namespace {
 constexpr int kN = 6;
 constexpr int kSigmaPoints = 2 * kN + 1;
 
-// A sigma pose as rotation and translation: applying it to a vertex is 9 multiply-adds,
-// written out (Eigen's fixed 3x3 products are not inlined at -O2 in this loop).
-struct RigidMap {
-  double r[9];  // row-major
-  double t[3];
-  Vec3 operator()(const Vec3& p) const {
-    return {r[0] * p.x() + r[1] * p.y() + r[2] * p.z() + t[0],
-            r[3] * p.x() + r[4] * p.y() + r[5] * p.z() + t[1],
-            r[6] * p.x() + r[7] * p.y() + r[8] * p.z() + t[2]};
-  }
-};
-
-// The 2n+1 sigma poses T * Exp(+-sigma_i), T[0] = T, and the weights, shared by all vertices.
+// The 2n+1 sigma poses T * Exp(+-sigma_i), pose 0 = T, and the weights, shared by all
+// vertices. Structure-of-arrays: element e of pose i (rotation row-major, then translation)
+// is pose[e][i], so that they are written and read as whole vectors, not transposed.
 struct SigmaPoses {
-  std::array<RigidMap, kSigmaPoints> T;
+  double pose[12][kSigmaPoints];
   double wm0, wc0, wi;
 };
 
@@ -60,9 +49,9 @@ struct SigmaPoses {
 //   V rho = (1 - c theta^2) rho + c phi (phi . rho) + b phi x rho,
 //   a = sin(theta)/theta, b = (1 - cos(theta))/theta^2, c = (theta - sin(theta))/theta^3.
 // Negating xi flips the a K term of R and the terms of V rho that are odd in xi.
-// Writes out[1 + i] = T Exp(xi_i) and out[1 + n + i] = T Exp(-xi_i).
+// Writes pose 1 + i = T Exp(xi_i) and pose 1 + n + i = T Exp(-xi_i).
 COVTRACK_VECTOR_CLONES
-void exp_sigma_poses(const Mat3& R0, const Vec3& t0, const Mat6& S, std::array<RigidMap, kSigmaPoints>& out) {
+void exp_sigma_poses(const Mat3& R0, const Vec3& t0, const Mat6& S, double (&out)[12][kSigmaPoints]) {
   constexpr int kLanes = 8;  // the n = 6 columns and two zero columns: whole vectors
   double rx[kLanes] = {}, ry[kLanes] = {}, rz[kLanes] = {}, px[kLanes] = {}, py[kLanes] = {}, pz[kLanes] = {};
   for (int i = 0; i < kN; ++i)
@@ -113,10 +102,8 @@ void exp_sigma_poses(const Mat3& R0, const Vec3& t0, const Mat6& S, std::array<R
       minus[9 + r][i] = R0(r, 0) * (even[0] - odd[0]) + R0(r, 1) * (even[1] - odd[1]) + R0(r, 2) * (even[2] - odd[2]) + t0[r];
     }
   }
-  for (int i = 0; i < kN; ++i) {
-    for (int e = 0; e < 9; ++e) out[1 + i].r[e] = plus[e][i], out[1 + kN + i].r[e] = minus[e][i];
-    for (int e = 0; e < 3; ++e) out[1 + i].t[e] = plus[9 + e][i], out[1 + kN + i].t[e] = minus[9 + e][i];
-  }
+  for (int e = 0; e < 12; ++e)
+    for (int i = 0; i < kN; ++i) out[e][1 + i] = plus[e][i], out[e][1 + kN + i] = minus[e][i];
 }
 
 // The Cholesky factor L (A = L L^T, L lower) of a positive definite A; false where a pivot
@@ -153,10 +140,10 @@ SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut
   const Vec3 t = pose.T.translation();
   SigmaPoses s;
   for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) s.T[0].r[3 * i + j] = R(i, j);
-    s.T[0].t[i] = t[i];
+    for (int j = 0; j < 3; ++j) s.pose[3 * i + j][0] = R(i, j);
+    s.pose[9 + i][0] = t[i];
   }
-  exp_sigma_poses(R, t, S, s.T);
+  exp_sigma_poses(R, t, S, s.pose);
   s.wm0 = lambda / (kN + lambda);
   s.wc0 = s.wm0 + (1 - ut.alpha * ut.alpha + ut.beta);
   s.wi = 0.5 / (kN + lambda);
@@ -207,15 +194,16 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
   const double wm0 = s.wm0, wc0 = s.wc0, wi = s.wi;
   double u[kSigmaPoints][kBlock], v[kSigmaPoints][kBlock], zmin[kBlock], z0[kBlock];
   for (int j = 0; j < kBlock; ++j) {
-    const RigidMap& m = s.T[0];
-    z0[j] = zmin[j] = m.r[6] * px[j] + m.r[7] * py[j] + m.r[8] * pz[j] + m.t[2];
+    const auto& m = s.pose;
+    z0[j] = zmin[j] = m[6][0] * px[j] + m[7][0] * py[j] + m[8][0] * pz[j] + m[11][0];
   }
   for (int i = 0; i < kSigmaPoints; ++i) {
-    const RigidMap m = s.T[i];
+    double m[12];  // pose i
+    for (int e = 0; e < 12; ++e) m[e] = s.pose[e][i];
     for (int j = 0; j < kBlock; ++j) {
-      const double x = m.r[0] * px[j] + m.r[1] * py[j] + m.r[2] * pz[j] + m.t[0];
-      const double y = m.r[3] * px[j] + m.r[4] * py[j] + m.r[5] * pz[j] + m.t[1];
-      const double z = m.r[6] * px[j] + m.r[7] * py[j] + m.r[8] * pz[j] + m.t[2];
+      const double x = m[0] * px[j] + m[1] * py[j] + m[2] * pz[j] + m[9];
+      const double y = m[3] * px[j] + m[4] * py[j] + m[5] * pz[j] + m[10];
+      const double z = m[6] * px[j] + m[7] * py[j] + m[8] * pz[j] + m[11];
       // A point behind the camera gives a meaningless pixel here; the caller checks zmin.
       const double iz = 1 / z;
       cam.pixel_of_normalised(x * iz, y * iz, u[i][j], v[i][j]);

@@ -1,12 +1,15 @@
 // The outer region as the polygon of support lines of the hull of the confidence
 // ellipses: built from the mean hull's tangents and arcs where every check passes, else
 // searched for and refined where it is loose (see regions.hpp for the guarantee).
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 
 #include "covtrack/client/regions.hpp"
-#include "region_tangents.hpp"
+#include "regions_from_tangents.hpp"
 #include "vector_clones.hpp"
 
 namespace covtrack::client {
@@ -136,39 +139,61 @@ struct ArcLine {
 // v; shape xx, xy, yy): their supports and their corners' checks are loops over all lines
 // that vectorise, where line after line would wait on a square root and two divisions each.
 // Fixed arrays, so the compiler sees that they do not overlap; an object needing more lines
-// goes to the search. Line size() repeats line 0: corner p (of lines p and p + 1) needs no
-// wrap-around.
+// goes to the search. Lines size() to padded() repeat line 0, so that the loops run over
+// whole vectors and corner p (of lines p and p + 1) needs no wrap-around.
 struct ShortcutLines {
-  static constexpr std::size_t kMost = 64;
+  static constexpr std::size_t kMost = 64;  // a multiple of kVector
+  static constexpr std::size_t kVector = 8;
   double nx[kMost + 1], ny[kMost + 1], h[kMost + 1], u[kMost], v[kMost], xx[kMost], xy[kMost],
       yy[kMost], qx[kMost], qy[kMost], gap2[kMost];
   std::size_t count = 0;
 
   std::size_t size() const { return count; }
-  // offset = -infinity: the line is a support of its own ellipse (see close_with_supports).
-  // False when full.
-  bool push(const Ellipses& ellipses, const Vec2& normal, double offset, std::size_t ellipse) {
-    if (count == kMost) return false;
-    const Vec3 S = ellipses.shape(ellipse);
-    const Vec2 c = ellipses.centre(ellipse);
-    nx[count] = normal.x(), ny[count] = normal.y(), h[count] = offset;
-    u[count] = c.x(), v[count] = c.y(), xx[count] = S[0], xy[count] = S[1], yy[count] = S[2];
-    ++count;
+  std::size_t padded() const { return (count + kVector - 1) / kVector * kVector; }
+  // The arc of `ellipse` from `start` (a common tangent: normal, offset) towards the normal
+  // `end` in 2^halvings directions, uniform in angle: lines count .. count + 2^halvings - 1.
+  // The offsets of all but the first are -infinity: supports of their own ellipse, filled
+  // in by close_with_supports. False when full.
+  bool add_arc(const Ellipses& ellipses, const ArcLine& start, const Vec2& end, int halvings) {
+    const std::size_t n = std::size_t{1} << halvings, p = count;
+    if (p + n > kMost) return false;
+    double *x = nx + p, *y = ny + p;
+    // By halving: each direction the normalised sum of its neighbours on the level above.
+    // The sums of one level all span the same angle, so one length serves for them all. (End
+    // goes to line p + n, the next arc's start, or for the last arc the spare entry: both
+    // are written again.)
+    x[0] = start.normal.x(), y[0] = start.normal.y(), x[n] = end.x(), y[n] = end.y();
+    for (std::size_t gap = n; gap > 1; gap /= 2) {
+      const std::size_t half = gap / 2;
+      const double sx = x[0] + x[gap], sy = y[0] + y[gap], inverse_length = 1 / std::sqrt(sx * sx + sy * sy);
+      for (std::size_t j = half; j < n; j += gap)
+        x[j] = (x[j - half] + x[j + half]) * inverse_length, y[j] = (y[j - half] + y[j + half]) * inverse_length;
+    }
+    const Vec3 S = ellipses.shape(start.ellipse);
+    const Vec2 c = ellipses.centre(start.ellipse);
+    for (std::size_t j = p; j < p + n; ++j)
+      h[j] = -std::numeric_limits<double>::infinity(), u[j] = c.x(), v[j] = c.y(), xx[j] = S[0], xy[j] = S[1], yy[j] = S[2];
+    h[p] = start.offset;
+    count = p + n;
     return true;
   }
 };
 
 // Fills the supports (a given offset, a common tangent's, is already the larger of two
-// ellipses' supports, so the maximum keeps it) and closes the cycle.
+// ellipses' supports, so the maximum keeps it), closes the cycle and pads.
 COVTRACK_VECTOR_CLONES
 void close_with_supports(ShortcutLines& lines) {
-  const std::size_t n = lines.count;
+  const std::size_t n = lines.padded();
+  for (std::size_t p = lines.count; p <= n; ++p) {
+    lines.nx[p] = lines.nx[0], lines.ny[p] = lines.ny[0], lines.h[p] = lines.h[0];
+    if (p < n) lines.u[p] = lines.u[0], lines.v[p] = lines.v[0], lines.xx[p] = lines.xx[0], lines.xy[p] = lines.xy[0], lines.yy[p] = lines.yy[0];
+  }
   for (std::size_t p = 0; p < n; ++p) {
     const double x = lines.nx[p], y = lines.ny[p];
     const double support = x * lines.u[p] + y * lines.v[p] + std::sqrt(std::max(x * x * lines.xx[p] + 2 * x * y * lines.xy[p] + y * y * lines.yy[p], 0.0));
     lines.h[p] = std::max(lines.h[p], support);
   }
-  lines.nx[n] = lines.nx[0], lines.ny[n] = lines.ny[0], lines.h[n] = lines.h[0];
+  lines.h[n] = lines.h[0];
 }
 
 // Corner p of lines p and p + 1, and whether each lies within tol of the point of line
@@ -178,7 +203,8 @@ void close_with_supports(ShortcutLines& lines) {
 // out in scalars here: through Eigen's Vec2 the loop does not vectorise.)
 COVTRACK_VECTOR_CLONES
 bool corners_within(ShortcutLines& lines, double tol) {
-  const std::size_t n = lines.count;
+  // The padding's corners (of equal lines) are computed, and not checked.
+  const std::size_t n = lines.padded();
   for (std::size_t p = 0; p < n; ++p) {
     const double ax = lines.nx[p], ay = lines.ny[p], bx = lines.nx[p + 1], by = lines.ny[p + 1];
     const double inverse_det = 1 / (ax * by - ay * bx);
@@ -191,64 +217,168 @@ bool corners_within(ShortcutLines& lines, double tol) {
     lines.gap2[p] = dx * dx + dy * dy;
     lines.qx[p] = cx, lines.qy[p] = cy;
   }
-  for (std::size_t p = 0; p < n; ++p)
+  for (std::size_t p = 0; p < lines.count; ++p)
     if (!(lines.gap2[p] <= tol * tol)) return false;
   return true;
 }
 
+// A block of arcs side by side (see arc_halvings): start and end normals, the shape of the
+// ellipse (xx, xy, yy), and the count of halvings found.
+constexpr int kArcs = 8;
+struct ArcBlock {
+  double sx[kArcs], sy[kArcs], ex[kArcs], ey[kArcs], xx[kArcs], xy[kArcs], yy[kArcs];
+  std::int64_t halvings[kArcs];
+};
+
+// Each arc's count of halvings in loops of fixed length without branches, which vectorise
+// (vector_clones.hpp): each count is a chain of square roots and divisions that would leave
+// the processor waiting, arc after arc. Very large where an arc turns clockwise or by about
+// pi, or is on a segment (a degenerate ellipse).
+COVTRACK_VECTOR_CLONES
+void block_halvings(ArcBlock& arcs, double tol) {
+  constexpr double pi = std::numbers::pi, inf = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < kArcs; ++j) {
+    // An upper bound of the arc's angle, without trigonometry: theta = 2 atan(x),
+    // x = cross / (1 + dot), and atan(x) is within 0.005 rad of x / (1 + 0.28125 x^2) for
+    // |x| <= 1 (of pi/2 - x / (x^2 + 0.28125) beyond).
+    const double cross = arcs.sx[j] * arcs.ey[j] - arcs.sy[j] * arcs.ex[j];
+    const double dot = arcs.sx[j] * arcs.ex[j] + arcs.sy[j] * arcs.ey[j];
+    const double x = cross / (1 + dot);
+    const double half = x <= 1 ? x / (1 + 0.28125 * x * x) : pi / 2 - x / (x * x + 0.28125);
+    const double angle2 = 4 * (half + 0.005) * (half + 0.005);
+    // ratio = (angle / step)^2, with step the widest gap whose corner stays within tol of
+    // a circle of the ellipse's largest radius of curvature rho = a^2 / b (semi-axes
+    // a >= b): (step / 2)^2 = 2r / (1 + r), r = tol / rho, so ratio = angle^2 (rho + tol) /
+    // (8 tol). A point (rho = 0) takes any gap below pi, a segment (rho infinite) none.
+    const double mid = 0.5 * (arcs.xx[j] + arcs.yy[j]), d = 0.5 * (arcs.xx[j] - arcs.yy[j]);
+    const double spread = std::sqrt(d * d + arcs.xy[j] * arcs.xy[j]);
+    const double a2 = mid + spread, b2 = std::max(mid - spread, 0.0);
+    const double rho = a2 / std::sqrt(b2);
+    const bool turns = (cross > 1e-9) & (dot >= -0.99);
+    const double arc_ratio = a2 > 0 ? angle2 * (rho + tol) / (8 * tol) : angle2 / (pi * pi);
+    const double ratio = turns ? arc_ratio : inf;
+    // The fewest halvings h with ratio <= 4^h, that is 2h >= ceil(log2(ratio)), read off
+    // the bits of the (non-negative) double: its exponent, plus one unless the mantissa is
+    // zero. Infinity and NaN give about 512, zero and subnormals none.
+    const std::uint64_t bits = std::bit_cast<std::uint64_t>(ratio);
+    const std::int64_t exponent = static_cast<std::int64_t>(bits >> 52) - 1023;
+    const std::int64_t ceil_log2 = exponent + ((bits & 0xFFFFFFFFFFFFFull) != 0 ? 1 : 0);
+    arcs.halvings[j] = std::max<std::int64_t>((ceil_log2 + 1) >> 1, 0);
+  }
+}
+
 // How many times each arc's angle is halved (see expand_by_arcs): arc i runs from the
-// normal of tangents[i] to that of the next, on tangents[i]'s ellipse. Blocks of arcs side
-// by side, in loops of fixed length that vectorise: each count is a chain of square roots
-// and divisions that would leave the processor waiting, arc after arc. False where an arc
+// normal of tangents[i] to that of the next, on tangents[i]'s ellipse. False where an arc
 // turns clockwise or by about pi, or needs more than `most` halvings (a sharp or
 // degenerate ellipse).
 bool arc_halvings(const Ellipses& ellipses, std::span<const ArcLine> tangents, double tol, int most,
                   std::vector<int>& halvings) {
-  constexpr int kArcs = 8;  // per block; a short last block repeats its first arc
-  constexpr double pi = std::numbers::pi, inf = std::numeric_limits<double>::infinity();
   const std::size_t k = tangents.size();
   halvings.resize(k);
+  ArcBlock arcs;
   for (std::size_t first = 0; first < k; first += kArcs) {
     const int count = static_cast<int>(std::min<std::size_t>(kArcs, k - first));
-    double sx[kArcs], sy[kArcs], ex[kArcs], ey[kArcs], xx[kArcs], xy[kArcs], yy[kArcs], ratio[kArcs];
-    for (int j = 0; j < kArcs; ++j) {
+    for (int j = 0; j < kArcs; ++j) {  // a short last block repeats its first arc
       const std::size_t i = first + (j < count ? j : 0);
       const Vec2& start = tangents[i].normal;
       const Vec2& end = tangents[i + 1 == k ? 0 : i + 1].normal;
       const Vec3 S = ellipses.shape(tangents[i].ellipse);
-      sx[j] = start.x(), sy[j] = start.y(), ex[j] = end.x(), ey[j] = end.y();
-      xx[j] = S[0], xy[j] = S[1], yy[j] = S[2];
+      arcs.sx[j] = start.x(), arcs.sy[j] = start.y(), arcs.ex[j] = end.x(), arcs.ey[j] = end.y();
+      arcs.xx[j] = S[0], arcs.xy[j] = S[1], arcs.yy[j] = S[2];
     }
-    for (int j = 0; j < kArcs; ++j) {
-      // An upper bound of the arc's angle, without trigonometry: theta = 2 atan(x),
-      // x = cross / (1 + dot), and atan(x) is within 0.005 rad of x / (1 + 0.28125 x^2) for
-      // |x| <= 1 (of pi/2 - x / (x^2 + 0.28125) beyond).
-      const double cross = sx[j] * ey[j] - sy[j] * ex[j], dot = sx[j] * ex[j] + sy[j] * ey[j];
-      const double x = cross / (1 + dot);
-      const double half = x <= 1 ? x / (1 + 0.28125 * x * x) : pi / 2 - x / (x * x + 0.28125);
-      const double angle2 = 4 * (half + 0.005) * (half + 0.005);
-      // ratio = (angle / step)^2, with step the widest gap whose corner stays within tol of
-      // a circle of the ellipse's largest radius of curvature rho = a^2 / b (semi-axes
-      // a >= b): (step / 2)^2 = 2r / (1 + r), r = tol / rho, so ratio = angle^2 (rho + tol) /
-      // (8 tol). A point (rho = 0) takes any gap below pi, a segment (rho infinite) none.
-      const double mid = 0.5 * (xx[j] + yy[j]), d = 0.5 * (xx[j] - yy[j]);
-      const double spread = std::sqrt(d * d + xy[j] * xy[j]);
-      const double a2 = mid + spread, b2 = std::max(mid - spread, 0.0);
-      const double rho = a2 / std::sqrt(b2);
-      const bool turns = (cross > 1e-9) & (dot >= -0.99);
-      const double arc_ratio = a2 > 0 ? angle2 * (rho + tol) / (8 * tol) : angle2 / (pi * pi);
-      ratio[j] = turns ? arc_ratio : inf;
-    }
-    // The fewest halvings h with ratio <= 4^h.
+    block_halvings(arcs, tol);
     for (int j = 0; j < count; ++j) {
-      int h = 0;
-      double power = 1;  // 4^h
-      for (; h <= most && !(ratio[j] <= power); ++h) power *= 4;
-      if (h > most) return false;
-      halvings[first + j] = h;
+      if (arcs.halvings[j] > most) return false;
+      halvings[first + j] = static_cast<int>(arcs.halvings[j]);
     }
   }
   return true;
+}
+
+// Whether every arc between consecutive tangents turns counter-clockwise (see refine_hull).
+bool arcs_turn(std::span<const TangentLine> tangents) {
+  for (std::size_t i = 0; i < tangents.size(); ++i)
+    if (!(cross(tangents[i].normal, tangents[i + 1 == tangents.size() ? 0 : i + 1].normal) > 1e-9)) return false;
+  return true;
+}
+
+// The hull of the ellipses can differ from the mean hull in two ways, both mended here
+// before its tangents are solved anew (for a few rounds; whether the result holds every
+// ellipse is checked later, as for any hull):
+//  - an ellipse of a vertex inside the mean hull sticks out of an edge's tangent: it goes
+//    into the hull there (the one sticking out most, per edge);
+//  - the ellipse of a hull vertex is swallowed by its neighbours': the tangent to the
+//    previous vertex turns past the one to the next (the arc between them would turn
+//    clockwise), so it has no arc on the boundary: it leaves the hull.
+// False where fewer than 3 vertices are left or the rounds run out.
+bool refine_hull(const Ellipses& ellipses, std::span<const ProjectedVertex> vertices, double s2,
+                 std::vector<int>& hull, std::vector<TangentLine>& solved) {
+  thread_local std::vector<int> next;
+  thread_local std::vector<std::pair<double, int>> worst;  // per edge: excess, ellipse
+  for (int round = 0; round < 4; ++round) {
+    const std::size_t k = hull.size();
+    worst.assign(k, {0.0, -1});
+    for (std::size_t e = 0; e < vertices.size(); ++e) {
+      if (std::find(hull.begin(), hull.end(), static_cast<int>(e)) != hull.end()) continue;
+      for (std::size_t i = 0; i < k; ++i) {
+        const Vec2& n = solved[i].normal;
+        const Vec2 far = ellipses.farthest_point(e, n);
+        const double excess = n.dot(far) - solved[i].offset - 1e-9 * (1 + std::abs(solved[i].offset));
+        if (excess > worst[i].first) worst[i] = {excess, static_cast<int>(e)};
+      }
+    }
+    next.clear();
+    for (std::size_t i = 0; i < k; ++i) {
+      const std::size_t after = i + 1 == k ? 0 : i + 1;  // the arc of vertex `after`
+      if (cross(solved[i].normal, solved[after].normal) > 1e-9) next.push_back(hull[after]);
+      if (worst[after].second >= 0) next.push_back(worst[after].second);  // in edge after -> after + 1
+    }
+    if (next.size() < 3) return false;
+    // Unchanged, `next` is the hull from its second vertex round to its first.
+    const bool changed = next.size() != k || !std::equal(next.begin(), next.end() - 1, hull.begin() + 1) || next.back() != hull.front();
+    if (!changed) return true;
+    hull.swap(next);
+    hull_tangents(hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return vertices[hull[i]]; }, s2,
+                  nullptr, &solved);
+  }
+  return false;
+}
+
+// The shortcut's polygon from the tangents of a hull of the ellipses (hull[i] -> hull[i + 1]
+// starts the arc of ellipse hull[i + 1]): see expand_by_arcs.
+enum class ArcsResult { built, sticks_out, failed };
+ArcsResult arcs_polygon(Ellipses& ellipses, std::span<const int> hull, std::span<const TangentLine> solved,
+                        const RegionOptions& o, Polygon& outer) {
+  const std::size_t k = hull.size();
+  constexpr int kMostHalvings = 6;  // 64 lines per arc
+  const double tol = o.max_polygon_error_px;
+  thread_local std::vector<ArcLine> tangents;
+  tangents.resize(k);
+  for (std::size_t i = 0; i < k; ++i) {
+    if (!solved[i].solved) return ArcsResult::failed;
+    tangents[i] = {solved[i].normal, solved[i].offset, static_cast<std::size_t>(hull[(i + 1) % k])};
+  }
+  thread_local std::vector<int> halvings;
+  if (!arc_halvings(ellipses, tangents, tol, kMostHalvings, halvings)) return ArcsResult::failed;
+  thread_local ShortcutLines lines;
+  lines.count = 0;
+  for (std::size_t i = 0; i < k; ++i)
+    if (!lines.add_arc(ellipses, tangents[i], tangents[i + 1 == k ? 0 : i + 1].normal, halvings[i])) return ArcsResult::failed;
+  if (static_cast<int>(lines.size()) > o.max_outer_corners) return ArcsResult::failed;
+  close_with_supports(lines);
+  // Every line a support of the whole set (to rounding), every corner within the tolerance
+  // of its arc's ellipse.
+  const std::size_t padded = lines.padded();
+  const std::span<const double> nx(lines.nx, padded), ny(lines.ny, padded), h(lines.h, padded);
+  if (!ellipses.hold_all(nx, ny, h)) return ArcsResult::sticks_out;
+  if (!corners_within(lines, tol)) return ArcsResult::failed;
+  outer.clear();
+  for (std::size_t p = 0; p < lines.size(); ++p) {
+    const Vec2 q(lines.qx[p], lines.qy[p]);
+    if (outer.empty() || (q - outer.back()).squaredNorm() > 1e-18) outer.push_back(q);
+  }
+  while (outer.size() > 1 && (outer.front() - outer.back()).squaredNorm() <= 1e-18) outer.pop_back();
+  return ArcsResult::built;
 }
 
 // The shortcut. Usually the boundary of the ellipses' hull is an arc of each mean hull
@@ -258,59 +388,23 @@ bool arc_halvings(const Ellipses& ellipses, std::span<const ArcLine> tangents, d
 // within the tolerance (the circle bound rho (1/cos(g/2) - 1) <= tol holds for
 // g/2 <= sqrt(2r / (1 + r)), r = tol / rho). Nothing is assumed: every line is checked to be a
 // support of the whole set and every corner to be within the tolerance of its ellipse's
-// point facing it, as in the search. It returns false where any check fails (an ellipse off
-// the mean hull sticking out, one swallowed by its neighbours, a sharp or degenerate arc):
-// the caller then searches.
-bool expand_by_arcs(Ellipses& ellipses, std::span<const ProjectedVertex> vertices,
-                    std::span<const int> hull, double s2, const RegionOptions& o, Polygon& outer) {
-  const std::size_t k = hull.size();
-  if (k < 3) return false;
-  constexpr int kMostHalvings = 6;  // 64 lines per arc
-  const double tol = o.max_polygon_error_px;
-
-  // The tangent of hull edge i (hull[i] -> hull[i + 1]) starts the arc of ellipse hull[i + 1].
+// point facing it, as in the search. Where the ellipses' hull is not the mean hull's it is
+// mended (refine_hull) and tried again. It returns false where any check still fails (a
+// sharp or degenerate arc, say): the caller then searches.
+bool expand_by_arcs(Ellipses& ellipses, std::span<const ProjectedVertex> vertices, double s2,
+                    std::span<const int> mean_hull, std::span<const TangentLine> mean_solved,
+                    const RegionOptions& o, Polygon& outer) {
+  if (mean_hull.size() < 3 || mean_solved.size() != mean_hull.size()) return false;
+  if (arcs_turn(mean_solved)) {
+    const ArcsResult first = arcs_polygon(ellipses, mean_hull, mean_solved, o, outer);
+    if (first != ArcsResult::sticks_out) return first == ArcsResult::built;
+  }
+  thread_local std::vector<int> hull;
   thread_local std::vector<TangentLine> solved;
-  thread_local std::vector<ArcLine> tangents;
-  hull_tangents(k, [&](std::size_t i) -> const ProjectedVertex& { return vertices[hull[i]]; }, s2,
-                TangentSide::outer, solved);
-  tangents.resize(k);
-  for (std::size_t i = 0; i < k; ++i) {
-    if (!solved[i].solved) return false;
-    tangents[i] = {solved[i].normal, solved[i].offset, static_cast<std::size_t>(hull[(i + 1) % k])};
-  }
-
-  thread_local std::vector<int> halvings;
-  if (!arc_halvings(ellipses, tangents, tol, kMostHalvings, halvings)) return false;
-  thread_local ShortcutLines lines;
-  lines.count = 0;
-  constexpr double kUnknown = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < k; ++i) {
-    const ArcLine& start = tangents[i];
-    const Vec2& end = tangents[(i + 1) % k].normal;
-    if (!lines.push(ellipses, start.normal, start.offset, start.ellipse)) return false;
-    // Directions by halving: normalised sums of neighbours, uniform in angle.
-    const int n = 1 << halvings[i];
-    Vec2 dirs[(1 << kMostHalvings) + 1];
-    dirs[0] = start.normal, dirs[n] = end;
-    for (int gap = n; gap > 1; gap /= 2)
-      for (int j = gap / 2; j < n; j += gap) dirs[j] = (dirs[j - gap / 2] + dirs[j + gap / 2]).normalized();
-    for (int j = 1; j < n; ++j)
-      if (!lines.push(ellipses, dirs[j], kUnknown, start.ellipse)) return false;
-    if (static_cast<int>(lines.size()) > o.max_outer_corners) return false;
-  }
-  close_with_supports(lines);
-  // Every line a support of the whole set (to rounding), every corner within the tolerance
-  // of its arc's ellipse.
-  const std::span<const double> nx(lines.nx, lines.size()), ny(lines.ny, lines.size()), h(lines.h, lines.size());
-  if (!ellipses.hold_all(nx, ny, h)) return false;
-  if (!corners_within(lines, tol)) return false;
-  outer.clear();
-  for (std::size_t p = 0; p < lines.size(); ++p) {
-    const Vec2 q(lines.qx[p], lines.qy[p]);
-    if (outer.empty() || (q - outer.back()).squaredNorm() > 1e-18) outer.push_back(q);
-  }
-  while (outer.size() > 1 && (outer.front() - outer.back()).squaredNorm() <= 1e-18) outer.pop_back();
-  return true;
+  hull.assign(mean_hull.begin(), mean_hull.end());
+  solved.assign(mean_solved.begin(), mean_solved.end());
+  return refine_hull(ellipses, vertices, s2, hull, solved) &&
+         arcs_polygon(ellipses, hull, solved, o, outer) == ArcsResult::built;
 }
 
 }  // namespace
@@ -319,13 +413,13 @@ bool expand_by_arcs(Ellipses& ellipses, std::span<const ProjectedVertex> vertice
 // supports' loop is compiled for the clone's instructions too.
 [[gnu::flatten]] COVTRACK_VECTOR_CLONES
 void expand_region(std::span<const ProjectedVertex> vertices, std::span<const int> mean_hull,
-                   const RegionOptions& o, Polygon& outer) {
+                   std::span<const TangentLine> outer_lines, const RegionOptions& o, Polygon& outer) {
   outer.clear();
   if (vertices.empty()) return;
   const double s2 = std::pow(confidence_scale(o.confidence), 2);
   thread_local Ellipses ellipses;
   ellipses.assign(vertices, s2);
-  if (o.outer_by_arcs && expand_by_arcs(ellipses, vertices, mean_hull, s2, o, outer)) return;
+  if (o.outer_by_arcs && expand_by_arcs(ellipses, vertices, s2, mean_hull, outer_lines, o, outer)) return;
   outer.clear();  // the shortcut may have left corners behind
   const double tolerance2 = o.max_polygon_error_px * o.max_polygon_error_px;
 
@@ -367,6 +461,17 @@ void expand_region(std::span<const ProjectedVertex> vertices, std::span<const in
   }
   // The last corner (between the lines at 2 pi and 0) repeats the first when they meet.
   while (outer.size() > 1 && (outer.front() - outer.back()).squaredNorm() <= 1e-18) outer.pop_back();
+}
+
+void expand_region(std::span<const ProjectedVertex> vertices, std::span<const int> mean_hull,
+                   const RegionOptions& o, Polygon& outer) {
+  // The shortcut starts from the outer lines of the mean hull's edges (region_tangents.hpp).
+  thread_local std::vector<TangentLine> lines;
+  lines.clear();
+  if (o.outer_by_arcs && mean_hull.size() >= 3)
+    hull_tangents(mean_hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return vertices[mean_hull[i]]; },
+                  std::pow(confidence_scale(o.confidence), 2), nullptr, &lines);
+  expand_region(vertices, mean_hull, lines, o, outer);
 }
 
 void expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& o,

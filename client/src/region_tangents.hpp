@@ -3,36 +3,34 @@
 // counter-clockwise hull), solved a block of pairs at a time. The inner region (seed 5.5.2)
 // needs the line with both ellipses on its outer side, the outer region's shortcut the line
 // with both on its inner side.
-#include <algorithm>
 #include <vector>
 
 #include "covtrack/client/regions.hpp"
 
 namespace covtrack::client {
 
-constexpr int kTangentPairs = 8;
-
 enum class TangentSide { inner, outer };
+
+// Pairs solved at once: two vectors of 8 with AVX-512, one object's inner and outer lines
+// (up to 8 edges) in one call.
+constexpr int kTangentLanes = 16;
 
 struct TangentBlock {
   // Inputs per pair (ellipse a, then b counter-clockwise): centres and shapes (the
-  // covariance scaled to the confidence: xx, xy, yy).
-  double au[kTangentPairs], av[kTangentPairs], axx[kTangentPairs], axy[kTangentPairs], ayy[kTangentPairs];
-  double bu[kTangentPairs], bv[kTangentPairs], bxx[kTangentPairs], bxy[kTangentPairs], byy[kTangentPairs];
+  // covariance scaled to the confidence: xx, xy, yy), and the side: -1 inner, +1 outer.
+  double au[kTangentLanes], av[kTangentLanes], axx[kTangentLanes], axy[kTangentLanes], ayy[kTangentLanes];
+  double bu[kTangentLanes], bv[kTangentLanes], bxx[kTangentLanes], bxy[kTangentLanes], byy[kTangentLanes];
+  double side[kTangentLanes];
   // Outputs per pair: the unit normal, pointing out of the object, and the offset of the
   // half-plane n . x <= offset; solved is 0 where one ellipse reaches past the other along
   // the edge, so that no such tangent exists (then the line is along the edge normal).
-  double nu[kTangentPairs], nv[kTangentPairs], offset[kTangentPairs], solved[kTangentPairs];
+  double nu[kTangentLanes], nv[kTangentLanes], offset[kTangentLanes], solved[kTangentLanes];
 };
-
-// Pair j of the block from two projected vertices; `scale2` = the confidence scale squared.
-void set_tangent_pair(TangentBlock& block, int j, const ProjectedVertex& a,
-                      const ProjectedVertex& b, double scale2);
 
 // Inner: the ellipses lie in n . x >= offset' for the line's own offset, and offset is the
 // smaller of their inner supports, so the half-plane never reaches into either. Outer: the
 // larger of their supports, so the half-plane holds both.
-void common_tangents(TangentBlock& block, TangentSide side);
+void common_tangents(TangentBlock& block);
 
 // One edge's line from a block: normal . x <= offset (see common_tangents).
 struct TangentLine {
@@ -41,23 +39,37 @@ struct TangentLine {
   bool solved;
 };
 
-// The line of every hull edge i (vertex(i) -> vertex(i + 1), cyclic; vertex(i) gives a
-// const ProjectedVertex&), solved a block of edges at a time.
+// A hull's confidence ellipses as structure-of-arrays (centre u, v; shape xx, xy, yy),
+// repeated cyclically past the k hull vertices, so that the ellipses of a block's edges
+// (a = i, b = i + 1) are whole runs, copied a vector at a time.
+struct HullEllipses {
+  std::size_t k = 0;
+  std::vector<double> u, v, xx, xy, yy;
+};
+
+// The lines of every hull edge i (vertex i -> i + 1, cyclic) on each side asked for (a
+// null side is skipped). Both sides of up to 8 edges share a block.
+void hull_tangents(const HullEllipses& ellipses, std::vector<TangentLine>* inner,
+                   std::vector<TangentLine>* outer);
+
+// The same from the hull's vertices: vertex(i) gives the const ProjectedVertex& of hull
+// vertex i < k; `scale2` is the confidence scale squared.
 template <class HullVertex>
-void hull_tangents(std::size_t k, HullVertex vertex, double scale2, TangentSide side,
-                   std::vector<TangentLine>& lines) {
-  lines.resize(k);
-  TangentBlock block;
-  for (std::size_t first = 0; first < k; first += kTangentPairs) {
-    const int count = static_cast<int>(std::min<std::size_t>(kTangentPairs, k - first));
-    for (int j = 0; j < kTangentPairs; ++j) {  // a short block repeats its first edge
-      const std::size_t i = first + (j < count ? j : 0);
-      set_tangent_pair(block, j, vertex(i), vertex(i + 1 == k ? 0 : i + 1), scale2);
-    }
-    common_tangents(block, side);
-    for (int j = 0; j < count; ++j)
-      lines[first + j] = {Vec2(block.nu[j], block.nv[j]), block.offset[j], block.solved[j] != 0};
+void hull_tangents(std::size_t k, HullVertex vertex, double scale2, std::vector<TangentLine>* inner,
+                   std::vector<TangentLine>* outer) {
+  thread_local HullEllipses e;  // kept per thread: no allocation per object
+  // Whole halves of blocks (kTangentLanes / 2 edges), and the last edge's end.
+  constexpr std::size_t kHalf = kTangentLanes / 2;
+  const std::size_t entries = (k + kHalf - 1) / kHalf * kHalf + 1;
+  e.k = k;
+  for (auto* column : {&e.u, &e.v, &e.xx, &e.xy, &e.yy}) column->resize(entries);
+  for (std::size_t i = 0, vi = 0; i < entries; ++i, vi = vi + 1 == k ? 0 : vi + 1) {
+    const ProjectedVertex& p = vertex(vi);
+    const Mat2& C = p.covariance_px2;
+    e.u[i] = p.mean_px.x(), e.v[i] = p.mean_px.y();
+    e.xx[i] = scale2 * C(0, 0), e.xy[i] = scale2 * 0.5 * (C(0, 1) + C(1, 0)), e.yy[i] = scale2 * C(1, 1);
   }
+  hull_tangents(e, inner, outer);
 }
 
 inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }

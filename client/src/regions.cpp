@@ -3,7 +3,7 @@
 #include <limits>
 
 #include "covtrack/client/regions.hpp"
-#include "region_tangents.hpp"
+#include "regions_from_tangents.hpp"
 
 namespace covtrack::client {
 
@@ -57,19 +57,24 @@ void clip_box(std::span<const ProjectedVertex> hull, std::span<const TangentLine
 
 }  // namespace
 
-void contract_region(std::span<const ProjectedVertex> hull, const RegionOptions& o,
+void contract_region(std::span<const ProjectedVertex> hull, std::span<const TangentLine> inner_lines,
                      Polygon& inner) {
   inner.clear();
-  const std::size_t k = hull.size();
-  if (k < 3) return;  // a point or a segment has no interior to keep
-  const double s2 = std::pow(confidence_scale(o.confidence), 2);
-
-  // One line per hull edge, tangent to the ellipses at its ends (region_tangents.hpp).
-  thread_local std::vector<TangentLine> lines;
-  hull_tangents(k, [&](std::size_t i) -> const ProjectedVertex& { return hull[i]; }, s2, TangentSide::inner, lines);
-  if (!corners_of_consecutive_lines(lines, inner)) clip_box(hull, lines, inner);
+  if (hull.size() < 3) return;  // a point or a segment has no interior to keep
+  if (!corners_of_consecutive_lines(inner_lines, inner)) clip_box(hull, inner_lines, inner);
   // A sliver left by rounding is no region.
   if (inner.size() < 3 || polygon_area(inner) <= 1e-9) inner.clear();
+}
+
+void contract_region(std::span<const ProjectedVertex> hull, const RegionOptions& o,
+                     Polygon& inner) {
+  // One line per hull edge, tangent to the ellipses at its ends (region_tangents.hpp).
+  thread_local std::vector<TangentLine> lines;
+  lines.clear();
+  if (hull.size() >= 3)
+    hull_tangents(hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return hull[i]; },
+                  std::pow(confidence_scale(o.confidence), 2), &lines, nullptr);
+  contract_region(hull, lines, inner);
 }
 
 Polygon contract_region(std::span<const ProjectedVertex> hull, const RegionOptions& o) {

@@ -1,11 +1,12 @@
 #pragma once
 // Hot loops over fixed-size blocks are written so that the compiler vectorises them. Built
-// for the baseline x86-64 they get 2 doubles per instruction; this attribute adds a clone
-// for x86-64-v3 (AVX2, FMA: 4 doubles) chosen at load time by the CPU that runs it, so the
-// binary stays portable. Elsewhere, or built with -DCOVTRACK_NO_VECTOR_CLONES (to test the
+// for the baseline x86-64 they get 2 doubles per instruction; this attribute adds clones
+// for x86-64-v3 (AVX2, FMA: 4 doubles) and x86-64-v4 (AVX-512: 8 doubles, a block of 8 in
+// one instruction), the one used chosen at load time by the CPU that runs it, so the binary
+// stays portable. Elsewhere, or built with -DCOVTRACK_NO_VECTOR_CLONES (to test the
 // baseline code on a machine that has AVX2), it is empty and the loops stay plain.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(COVTRACK_NO_VECTOR_CLONES)
-#define COVTRACK_VECTOR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#define COVTRACK_VECTOR_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define COVTRACK_VECTOR_CLONES
 #endif

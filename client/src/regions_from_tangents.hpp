@@ -1,0 +1,18 @@
+#pragma once
+// The regions from hull-edge lines solved by the caller (region_tangents.hpp), so that an
+// object's inner and outer lines are solved together (compute_object_regions).
+#include <span>
+
+#include "region_tangents.hpp"
+
+namespace covtrack::client {
+
+// contract_region, from the hull's inner lines.
+void contract_region(std::span<const ProjectedVertex> hull, std::span<const TangentLine> inner_lines,
+                     Polygon& inner);
+
+// expand_region, from the mean hull's outer lines (empty: none solved, so the search).
+void expand_region(std::span<const ProjectedVertex> vertices, std::span<const int> mean_hull,
+                   std::span<const TangentLine> outer_lines, const RegionOptions& o, Polygon& outer);
+
+}  // namespace covtrack::client
