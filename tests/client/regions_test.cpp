@@ -169,9 +169,11 @@ TEST(OuterRegion, ContainsEveryEllipseAndStaysWithinTheBound) {
 }
 
 // Boxes as the benchmark frame has them: the shortcut applies to nearly all of them (its
-// corners differ from the search's) and keeps the guarantee.
+// corners differ from the search's) and keeps the guarantee. About 4% of them need the
+// mean hull mended first (an inner vertex's ellipse sticking out of an edge's tangent, a
+// hull vertex's swallowed by its neighbours'): without that the shortcut applies to 95%.
 TEST(OuterRegion, ShortcutAppliesToTypicalObjectsAndKeepsTheGuarantee) {
-  const test::BenchFrame f = test::make_bench_frame(100);
+  const test::BenchFrame f = test::make_bench_frame(1000);
   RegionOptions search;
   search.outer_by_arcs = false;
   int shortcut = 0;
@@ -182,7 +184,7 @@ TEST(OuterRegion, ShortcutAppliesToTypicalObjectsAndKeepsTheGuarantee) {
     shortcut += by_arcs != expand_region(vertices, search);
   }
   std::printf("the shortcut applied to %d of %zu objects\n", shortcut, f.poses.size());
-  EXPECT_GE(shortcut, 90);
+  EXPECT_GE(shortcut, 985);
 }
 
 // Zero covariance everywhere (sqrt(0) supports): the outer region is the hull of the
