@@ -39,14 +39,13 @@ void compute_object_regions(const Camera& camera, const UncertainPose& T_camera_
   // Every vertex's ellipse goes into the outer region, not only the hull's: a vertex just
   // inside the mean hull can still stick out once perturbed. The inner region needs only
   // the hull (a subset of the true vertices spans less, so it stays conservative).
-  // Both regions start from the hull edges' tangents, solved together: the inner and the
-  // outer solves are independent chains that the processor overlaps (region_tangents.hpp).
+  // Both regions start from the hull edges' tangents, both sides solved in one block
+  // (region_tangents.hpp).
   thread_local std::vector<TangentLine> inner_lines, outer_lines;
-  inner_lines.clear(), outer_lines.clear();
-  if (hull.size() >= 3)
-    hull_tangents(hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return hull[i]; },
-                  std::pow(confidence_scale(o.regions.confidence), 2), &inner_lines,
-                  o.regions.outer_by_arcs ? &outer_lines : nullptr);
+  outer_lines.clear();  // stays empty without the shortcut
+  hull_tangents(hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return hull[i]; },
+                std::pow(confidence_scale(o.regions.confidence), 2), &inner_lines,
+                o.regions.outer_by_arcs ? &outer_lines : nullptr);
   expand_region(r.vertices, r.hull, outer_lines, o.regions, r.outer);
   contract_region(hull, inner_lines, r.inner);
   r.assessment = assess(o.assessment, hull);

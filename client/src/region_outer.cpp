@@ -15,6 +15,12 @@
 namespace covtrack::client {
 namespace {
 
+// A line n . x <= offset holds a support up to this (rounding in the lines' own solves).
+double with_slack(double offset) { return offset + 1e-9 * (1 + std::abs(offset)); }
+
+// Normals turning by less than this (counter-clockwise) leave no arc between them.
+constexpr double kLeastTurn = 1e-9;
+
 // A support line of the set: normal . x <= offset, touching it at `contact`.
 struct SupportLine {
   Vec2 normal;  // unit
@@ -73,7 +79,7 @@ class Ellipses {
     limit_.resize(lines);
     worst_.assign(lines, -std::numeric_limits<double>::infinity());
     double *limit = limit_.data(), *worst = worst_.data();
-    for (std::size_t j = 0; j < lines; ++j) limit[j] = h[j] + 1e-9 * (1 + std::abs(h[j]));
+    for (std::size_t j = 0; j < lines; ++j) limit[j] = with_slack(h[j]);
     for (std::size_t i = 0; i < cu_.size(); ++i) {
       const double u = cu_[i], v = cv_[i], xx = sxx_[i], xy = sxy_[i], yy = syy_[i];
       for (std::size_t j = 0; j < lines; ++j) {
@@ -254,7 +260,7 @@ void block_halvings(ArcBlock& arcs, double tol) {
     const double spread = std::sqrt(d * d + arcs.xy[j] * arcs.xy[j]);
     const double a2 = mid + spread, b2 = std::max(mid - spread, 0.0);
     const double rho = a2 / std::sqrt(b2);
-    const bool turns = (cross > 1e-9) & (dot >= -0.99);
+    const bool turns = (cross > kLeastTurn) & (dot >= -0.99);
     const double arc_ratio = a2 > 0 ? angle2 * (rho + tol) / (8 * tol) : angle2 / (pi * pi);
     const double ratio = turns ? arc_ratio : inf;
     // The fewest halvings h with ratio <= 4^h, that is 2h >= ceil(log2(ratio)), read off
@@ -295,10 +301,13 @@ bool arc_halvings(const Ellipses& ellipses, std::span<const ArcLine> tangents, d
   return true;
 }
 
-// Whether every arc between consecutive tangents turns counter-clockwise (see refine_hull).
+// Whether the arc from tangent a to tangent b turns counter-clockwise (see refine_hull).
+bool arc_turns(const TangentLine& a, const TangentLine& b) { return cross(a.normal, b.normal) > kLeastTurn; }
+
+// Whether every arc between consecutive tangents does.
 bool arcs_turn(std::span<const TangentLine> tangents) {
   for (std::size_t i = 0; i < tangents.size(); ++i)
-    if (!(cross(tangents[i].normal, tangents[i + 1 == tangents.size() ? 0 : i + 1].normal) > 1e-9)) return false;
+    if (!arc_turns(tangents[i], tangents[i + 1 == tangents.size() ? 0 : i + 1])) return false;
   return true;
 }
 
@@ -323,14 +332,14 @@ bool refine_hull(const Ellipses& ellipses, std::span<const ProjectedVertex> vert
       for (std::size_t i = 0; i < k; ++i) {
         const Vec2& n = solved[i].normal;
         const Vec2 far = ellipses.farthest_point(e, n);
-        const double excess = n.dot(far) - solved[i].offset - 1e-9 * (1 + std::abs(solved[i].offset));
+        const double excess = n.dot(far) - with_slack(solved[i].offset);
         if (excess > worst[i].first) worst[i] = {excess, static_cast<int>(e)};
       }
     }
     next.clear();
     for (std::size_t i = 0; i < k; ++i) {
       const std::size_t after = i + 1 == k ? 0 : i + 1;  // the arc of vertex `after`
-      if (cross(solved[i].normal, solved[after].normal) > 1e-9) next.push_back(hull[after]);
+      if (arc_turns(solved[i], solved[after])) next.push_back(hull[after]);
       if (worst[after].second >= 0) next.push_back(worst[after].second);  // in edge after -> after + 1
     }
     if (next.size() < 3) return false;
@@ -467,8 +476,8 @@ void expand_region(std::span<const ProjectedVertex> vertices, std::span<const in
                    const RegionOptions& o, Polygon& outer) {
   // The shortcut starts from the outer lines of the mean hull's edges (region_tangents.hpp).
   thread_local std::vector<TangentLine> lines;
-  lines.clear();
-  if (o.outer_by_arcs && mean_hull.size() >= 3)
+  lines.clear();  // stays empty without the shortcut
+  if (o.outer_by_arcs)
     hull_tangents(mean_hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return vertices[mean_hull[i]]; },
                   std::pow(confidence_scale(o.confidence), 2), nullptr, &lines);
   expand_region(vertices, mean_hull, lines, o, outer);

@@ -53,10 +53,16 @@ void hull_tangents(const HullEllipses& ellipses, std::vector<TangentLine>* inner
                    std::vector<TangentLine>* outer);
 
 // The same from the hull's vertices: vertex(i) gives the const ProjectedVertex& of hull
-// vertex i < k; `scale2` is the confidence scale squared.
+// vertex i < k; `scale2` is the confidence scale squared. A point or a segment (k < 3) has
+// no edges to give lines: the sides asked for come back empty.
 template <class HullVertex>
 void hull_tangents(std::size_t k, HullVertex vertex, double scale2, std::vector<TangentLine>* inner,
                    std::vector<TangentLine>* outer) {
+  if (k < 3) {
+    for (auto* lines : {inner, outer})
+      if (lines) lines->clear();
+    return;
+  }
   thread_local HullEllipses e;  // kept per thread: no allocation per object
   // Whole halves of blocks (kTangentLanes / 2 edges), and the last edge's end.
   constexpr std::size_t kHalf = kTangentLanes / 2;

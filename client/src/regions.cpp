@@ -70,10 +70,8 @@ void contract_region(std::span<const ProjectedVertex> hull, const RegionOptions&
                      Polygon& inner) {
   // One line per hull edge, tangent to the ellipses at its ends (region_tangents.hpp).
   thread_local std::vector<TangentLine> lines;
-  lines.clear();
-  if (hull.size() >= 3)
-    hull_tangents(hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return hull[i]; },
-                  std::pow(confidence_scale(o.confidence), 2), &lines, nullptr);
+  hull_tangents(hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return hull[i]; },
+                std::pow(confidence_scale(o.confidence), 2), &lines, nullptr);
   contract_region(hull, lines, inner);
 }
 
