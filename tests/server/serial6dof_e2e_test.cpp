@@ -121,10 +121,21 @@ TEST(Serial6dofEndToEnd, EachProtocolThroughTheDaemonHasChiSquareNees) {
   test::DaemonProcess daemon(device_table(units[0], "fastrak", common + "model = \"is900\"\n") +
                                  device_table(units[1], "liberty", common) +
                                  device_table(units[2], "flock", common), url);
-  c.run_for(4.0);
+  // Collect until every unit has 700 poses (3.5 s at 100 Hz with two stations, after its
+  // reset) or 20 s pass. Not a fixed window from the daemon's start: a first open can be
+  // refused and retried after the back-off (seen once in CI: EBUSY on a fresh emulator's
+  // pseudo-terminal with no process holding it, 1.5 s lost), and the daemon handling
+  // that is not what this test measures.
+  const int kPoses = 700;
+  const auto enough = [&] {
+    for (const auto& u : units)
+      if (nees_of(c, u).n < kPoses) return false;
+    return true;
+  };
+  for (int waited = 0; waited < 40 && !enough(); ++waited) c.run_for(0.5);
   for (const auto& u : units) {
     const Nees n = nees_of(c, u);
-    ASSERT_GE(n.n, 400) << u.device;
+    ASSERT_GE(n.n, kPoses) << u.device << " (within 20 s)";
     EXPECT_NEAR(n.mean, 6.0, 3.29 * std::sqrt(12.0 / n.n)) << u.device << " over " << n.n;
     std::cout << "[ NEES ] " << u.device << " through covtrackd: mean " << n.mean << " over " << n.n
               << " poses\n";
@@ -182,8 +193,9 @@ TEST(Serial6dofEndToEnd, PseudoTerminalClosedMidRunGivesLostThenRecovers) {
       "[daemon]\nrestart_backoff_initial_s = 0.1\nrestart_backoff_max_s = 0.2\n" +
           device_table(unit, "liberty", "reset_time_s = 0.2\nrate_hz = 50\n"),
       url);
-  c.run_for(1.5);
-  ASSERT_FALSE(c.poses["unplugged/st1"].empty());
+  // Up and streaming first (a refused first open costs a back-off, see above).
+  for (int waited = 0; waited < 40 && c.poses["unplugged/st1"].size() < 25; ++waited) c.run_for(0.25);
+  ASSERT_GE(c.poses["unplugged/st1"].size(), 25u) << "the unit never streamed within 10 s";
   const std::int64_t unplugged_us = now_us();
   unit.emulator->unplug();
   c.run_for(0.6);
