@@ -9,15 +9,6 @@
 
 namespace covtrack::client {
 
-ProjectionFlags& ProjectionFlags::operator|=(const ProjectionFlags& o) {
-  behind_camera |= o.behind_camera;
-  sigma_point_behind_camera |= o.sigma_point_behind_camera;
-  rotation_too_uncertain |= o.rotation_too_uncertain;
-  unbounded |= o.unbounded;
-  covariance_repaired |= o.covariance_repaired;
-  return *this;
-}
-
 Mat26 pixel_jacobian_wrt_perturbation(const Camera& camera, const Pose& T, const Vec3& p) {
   // T Exp(xi) p ~ T (p + rho + phi x p) = T p + R (rho - skew(p) phi).
   Mat23 J_cam;
@@ -106,34 +97,41 @@ void exp_sigma_poses(const Mat3& R0, const Vec3& t0, const Mat6& S, double (&out
     for (int i = 0; i < kN; ++i) out[e][1 + i] = plus[e][i], out[e][1 + kN + i] = minus[e][i];
 }
 
-// The Cholesky factor L (A = L L^T, L lower) of a positive definite A; false where a pivot
-// is not positive (or not a number). Written out because Eigen's general LLT took twice as
-// long on a 6x6 (112 vs 53 ns, measured), and there is one per object per frame.
-bool cholesky6(const Mat6& A, Mat6& L) {
-  L.setZero();
+// A square root S (S S^T = scale A) of a positive definite A, from A = L D L^T (L unit lower
+// triangular): S = L sqrt(scale D), the Cholesky factor. Each column's pivot waits only on
+// one division of the previous columns, not on a square root and a division as in the
+// Cholesky factor itself; the six square roots come at the end, side by side. False where
+// a pivot is not positive (or not a number). Written out: Eigen's general LLT took twice as
+// long on a 6x6, and there is one per object per frame.
+bool scaled_square_root6(const Mat6& A, double scale, Mat6& S) {
+  double L[6][6], E[6][6], d[6];  // E = L D: column j of L times d_j
   for (int j = 0; j < 6; ++j) {
     double pivot = A(j, j);
-    for (int k = 0; k < j; ++k) pivot -= L(j, k) * L(j, k);
+    for (int k = 0; k < j; ++k) pivot -= E[j][k] * L[j][k];
     if (!(pivot > 0)) return false;
-    const double diagonal = std::sqrt(pivot), inverse = 1 / diagonal;
-    L(j, j) = diagonal;
+    d[j] = pivot;
+    const double inverse = 1 / pivot;
     for (int i = j + 1; i < 6; ++i) {
       double v = A(i, j);
-      for (int k = 0; k < j; ++k) v -= L(i, k) * L(j, k);
-      L(i, j) = v * inverse;
+      for (int k = 0; k < j; ++k) v -= E[i][k] * L[j][k];
+      E[i][j] = v;
+      L[i][j] = v * inverse;
     }
   }
+  double root[6];
+  for (int j = 0; j < 6; ++j) root[j] = std::sqrt(scale * d[j]);
+  for (int j = 0; j < 6; ++j)
+    for (int i = 0; i < 6; ++i) S(i, j) = i < j ? 0.0 : i == j ? root[j] : L[i][j] * root[j];
   return true;
 }
 
 SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut) {
   const double lambda = ut.alpha * ut.alpha * (kN + ut.kappa) - kN;
-  const Mat6 scaled = (kN + lambda) * pose.covariance;
-  // Cholesky is the cheap square root; a singular covariance (a degree of freedom known
-  // exactly) needs the eigen decomposition.
+  // The Cholesky factor is the cheap square root; a singular covariance (a degree of
+  // freedom known exactly) needs the eigen decomposition.
   Mat6 S;
-  if (!cholesky6(scaled, S)) {
-    Eigen::SelfAdjointEigenSolver<Mat6> eig(scaled);
+  if (!scaled_square_root6(pose.covariance, kN + lambda, S)) {
+    Eigen::SelfAdjointEigenSolver<Mat6> eig((kN + lambda) * pose.covariance);
     S = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
   }
   const Mat3 R = pose.T.linear();

@@ -141,6 +141,11 @@ struct ArcLine {
   std::size_t ellipse;  // of the arc this line starts or lies in
 };
 
+// An arc's directions after one halving (middle) and two (quarter, three quarters).
+struct ArcSplits {
+  Vec2 middle, quarter, three_quarters;
+};
+
 // The shortcut's lines as structure-of-arrays, each with the ellipse of its arc (centre u,
 // v; shape xx, xy, yy): their supports and their corners' checks are loops over all lines
 // that vectorise, where line after line would wait on a square root and two divisions each.
@@ -159,11 +164,21 @@ struct ShortcutLines {
   // The arc of `ellipse` from `start` (a common tangent: normal, offset) towards the normal
   // `end` in 2^halvings directions, uniform in angle: lines count .. count + 2^halvings - 1.
   // The offsets of all but the first are -infinity: supports of their own ellipse, filled
-  // in by close_with_supports. False when full.
-  bool add_arc(const Ellipses& ellipses, const ArcLine& start, const Vec2& end, int halvings) {
+  // in by close_with_supports. Up to two halvings take their directions from `splits`
+  // (block_halvings). False when full.
+  bool add_arc(const Ellipses& ellipses, const ArcLine& start, const Vec2& end, int halvings, const ArcSplits& splits) {
     const std::size_t n = std::size_t{1} << halvings, p = count;
     if (p + n > kMost) return false;
     double *x = nx + p, *y = ny + p;
+    if (halvings <= 2) {
+      x[0] = start.normal.x(), y[0] = start.normal.y();
+      if (halvings == 1) x[1] = splits.middle.x(), y[1] = splits.middle.y();
+      if (halvings == 2) {
+        x[1] = splits.quarter.x(), y[1] = splits.quarter.y(), x[2] = splits.middle.x(), y[2] = splits.middle.y();
+        x[3] = splits.three_quarters.x(), y[3] = splits.three_quarters.y();
+      }
+      return fill_arc(ellipses, start, n);
+    }
     // By halving: each direction the normalised sum of its neighbours on the level above.
     // The sums of one level all span the same angle, so one length serves for them all. (End
     // goes to line p + n, the next arc's start, or for the last arc the spare entry: both
@@ -175,6 +190,13 @@ struct ShortcutLines {
       for (std::size_t j = half; j < n; j += gap)
         x[j] = (x[j - half] + x[j + half]) * inverse_length, y[j] = (y[j - half] + y[j + half]) * inverse_length;
     }
+    return fill_arc(ellipses, start, n);
+  }
+
+ private:
+  // The rest of the arc's n lines after their normals: its ellipse, and the start's offset.
+  bool fill_arc(const Ellipses& ellipses, const ArcLine& start, std::size_t n) {
+    const std::size_t p = count;
     const Vec3 S = ellipses.shape(start.ellipse);
     const Vec2 c = ellipses.centre(start.ellipse);
     for (std::size_t j = p; j < p + n; ++j)
@@ -229,11 +251,13 @@ bool corners_within(ShortcutLines& lines, double tol) {
 }
 
 // A block of arcs side by side (see arc_halvings): start and end normals, the shape of the
-// ellipse (xx, xy, yy), and the count of halvings found.
+// ellipse (xx, xy, yy); out, the count of halvings found and the directions of the first two
+// (ArcSplits).
 constexpr int kArcs = 8;
 struct ArcBlock {
   double sx[kArcs], sy[kArcs], ex[kArcs], ey[kArcs], xx[kArcs], xy[kArcs], yy[kArcs];
   std::int64_t halvings[kArcs];
+  double mx[kArcs], my[kArcs], q1x[kArcs], q1y[kArcs], q3x[kArcs], q3y[kArcs];
 };
 
 // Each arc's count of halvings in loops of fixed length without branches, which vectorise
@@ -270,6 +294,17 @@ void block_halvings(ArcBlock& arcs, double tol) {
     const std::int64_t exponent = static_cast<std::int64_t>(bits >> 52) - 1023;
     const std::int64_t ceil_log2 = exponent + ((bits & 0xFFFFFFFFFFFFFull) != 0 ? 1 : 0);
     arcs.halvings[j] = std::max<std::int64_t>((ceil_log2 + 1) >> 1, 0);
+    // The first two halvings' directions, as ShortcutLines::add_arc would halve them (the
+    // same operations, so the same bits), here side by side for 99% of the arcs (2^h lines,
+    // h <= 2), where one arc at a time each level waited on a square root and a division.
+    // (NaN where the arc turns by pi: such an arc is refused above.)
+    const double first = 1 / std::sqrt((arcs.sx[j] + arcs.ex[j]) * (arcs.sx[j] + arcs.ex[j]) +
+                                       (arcs.sy[j] + arcs.ey[j]) * (arcs.sy[j] + arcs.ey[j]));
+    const double mx = (arcs.sx[j] + arcs.ex[j]) * first, my = (arcs.sy[j] + arcs.ey[j]) * first;
+    const double second = 1 / std::sqrt((arcs.sx[j] + mx) * (arcs.sx[j] + mx) + (arcs.sy[j] + my) * (arcs.sy[j] + my));
+    arcs.mx[j] = mx, arcs.my[j] = my;
+    arcs.q1x[j] = (arcs.sx[j] + mx) * second, arcs.q1y[j] = (arcs.sy[j] + my) * second;
+    arcs.q3x[j] = (mx + arcs.ex[j]) * second, arcs.q3y[j] = (my + arcs.ey[j]) * second;
   }
 }
 
@@ -278,9 +313,10 @@ void block_halvings(ArcBlock& arcs, double tol) {
 // turns clockwise or by about pi, or needs more than `most` halvings (a sharp or
 // degenerate ellipse).
 bool arc_halvings(const Ellipses& ellipses, std::span<const ArcLine> tangents, double tol, int most,
-                  std::vector<int>& halvings) {
+                  std::vector<int>& halvings, std::vector<ArcSplits>& splits) {
   const std::size_t k = tangents.size();
   halvings.resize(k);
+  splits.resize(k);
   ArcBlock arcs;
   for (std::size_t first = 0; first < k; first += kArcs) {
     const int count = static_cast<int>(std::min<std::size_t>(kArcs, k - first));
@@ -296,6 +332,7 @@ bool arc_halvings(const Ellipses& ellipses, std::span<const ArcLine> tangents, d
     for (int j = 0; j < count; ++j) {
       if (arcs.halvings[j] > most) return false;
       halvings[first + j] = static_cast<int>(arcs.halvings[j]);
+      splits[first + j] = {Vec2(arcs.mx[j], arcs.my[j]), Vec2(arcs.q1x[j], arcs.q1y[j]), Vec2(arcs.q3x[j], arcs.q3y[j])};
     }
   }
   return true;
@@ -368,11 +405,12 @@ ArcsResult arcs_polygon(Ellipses& ellipses, std::span<const int> hull, std::span
     tangents[i] = {solved[i].normal, solved[i].offset, static_cast<std::size_t>(hull[(i + 1) % k])};
   }
   thread_local std::vector<int> halvings;
-  if (!arc_halvings(ellipses, tangents, tol, kMostHalvings, halvings)) return ArcsResult::failed;
+  thread_local std::vector<ArcSplits> splits;
+  if (!arc_halvings(ellipses, tangents, tol, kMostHalvings, halvings, splits)) return ArcsResult::failed;
   thread_local ShortcutLines lines;
   lines.count = 0;
   for (std::size_t i = 0; i < k; ++i)
-    if (!lines.add_arc(ellipses, tangents[i], tangents[i + 1 == k ? 0 : i + 1].normal, halvings[i])) return ArcsResult::failed;
+    if (!lines.add_arc(ellipses, tangents[i], tangents[i + 1 == k ? 0 : i + 1].normal, halvings[i], splits[i])) return ArcsResult::failed;
   if (static_cast<int>(lines.size()) > o.max_outer_corners) return ArcsResult::failed;
   close_with_supports(lines);
   // Every line a support of the whole set (to rounding), every corner within the tolerance

@@ -1,17 +1,88 @@
 #include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <numeric>
 
 #include "covtrack/client/regions.hpp"
+#include "vector_clones.hpp"
 
 namespace covtrack::client {
 namespace {
 double cross(const Vec2& o, const Vec2& a, const Vec2& b) {
   return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
 }
+
+// Up to this many points (an object's box) take the hull by successors below.
+constexpr int kFewPoints = 8;
+
+// Vectors of 4 (AVX2 registers; two SSE registers in the baseline clone). GCC 12 splits
+// comparisons of 8-wide vectors into scalars, even with AVX-512.
+using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
+using Mask = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
+constexpr int kGroups = kFewPoints / 4;
+
+// For every point i at once (the lanes), the point j seen from i farthest clockwise, and of
+// those in line the farthest away: from a hull vertex that is the next one counter-clockwise
+// (every point lies left of or on the line to it). No sort and no branches, where sorting
+// and the chain's pops mispredicted on almost every comparison. Written with vector types:
+// as loops over arrays the running choice went through memory (masked stores).
+COVTRACK_VECTOR_CLONES
+void hull_successors(const double (&px)[kFewPoints], const double (&py)[kFewPoints], int n,
+                     std::int64_t (&successor)[kFewPoints]) {
+  // Inside, so that it is compiled (and inlined) for the clone's instructions. (A cast
+  // between vector types of one size keeps the bits.)
+  const auto take = [](Lanes& value, const Mask& where, const Lanes& new_value) {
+    value = (Lanes)(((Mask)new_value & where) | ((Mask)value & ~where));
+  };
+  Lanes x[kGroups], y[kGroups], bx[kGroups], by[kGroups], bd[kGroups];
+  Mask next[kGroups];
+  const Lanes zero = {};
+  for (int g = 0; g < kGroups; ++g) {
+    std::memcpy(&x[g], px + 4 * g, sizeof(Lanes));
+    std::memcpy(&y[g], py + 4 * g, sizeof(Lanes));
+    bx[g] = x[g], by[g] = y[g], bd[g] = zero;
+    next[g] = Mask{0, 1, 2, 3} + 4 * g;
+  }
+  for (int j = 0; j < n; ++j) {
+    const Lanes xj = zero + px[j], yj = zero + py[j];
+#pragma GCC unroll 2
+    for (int g = 0; g < kGroups; ++g) {
+      const Lanes dx = xj - x[g], dy = yj - y[g];
+      const Lanes turn = (bx[g] - x[g]) * dy - (by[g] - y[g]) * dx, d = dx * dx + dy * dy;
+      const Mask better = (turn < zero) | ((turn == zero) & (d > bd[g]));
+      take(bx[g], better, xj), take(by[g], better, yj), take(bd[g], better, d);
+      next[g] = ((Mask{} + j) & better) | (next[g] & ~better);
+    }
+  }
+  for (int g = 0; g < kGroups; ++g) std::memcpy(successor + 4 * g, &next[g], sizeof(Mask));
+}
+
+// The hull of 3 to kFewPoints points as convex_hull_indices gives it; false where rounding
+// made the successors inconsistent (the caller then sorts).
+bool few_points_hull(std::span<const Vec2> p, std::vector<int>& h) {
+  const int n = static_cast<int>(p.size());
+  double x[kFewPoints], y[kFewPoints];
+  int start = 0;
+  for (int i = 0; i < kFewPoints; ++i) {
+    const Vec2& q = p[i < n ? i : 0];  // the padding repeats point 0 and is never followed
+    x[i] = q.x(), y[i] = q.y();
+    if (i < n && (q.x() < x[start] || (q.x() == x[start] && q.y() < y[start]))) start = i;
+  }
+  std::int64_t next[kFewPoints];
+  hull_successors(x, y, n, next);
+  h.clear();
+  int i = start;
+  do {
+    h.push_back(i);
+    i = static_cast<int>(next[i]);
+  } while (i != start && static_cast<int>(h.size()) < n);
+  return i == start;
+}
 }  // namespace
 
 void convex_hull_indices(std::span<const Vec2> p, std::vector<int>& h) {
   const int n = static_cast<int>(p.size());
+  if (n >= 3 && n <= kFewPoints && few_points_hull(p, h)) return;
   thread_local std::vector<int> idx;  // kept per thread: no allocation per object
   idx.resize(n);
   std::iota(idx.begin(), idx.end(), 0);

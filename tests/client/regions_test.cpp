@@ -113,6 +113,30 @@ TEST(ConvexHull, PrefilteredHullEqualsPlainMonotoneChain) {
   }
 }
 
+// Up to 8 points (an object's box) the hull is taken by successors without a sort; more
+// take the monotone chain. Copies of point 0 appended up to 9 points leave the hull as it
+// is, so each few-point hull is compared with the chain's. Points on a small grid repeat and
+// line up often; Gaussian points are in general position.
+TEST(ConvexHull, FewPointsGiveTheMonotoneChainsHull) {
+  std::mt19937_64 rng(4);
+  std::uniform_int_distribution<int> grid(0, 3);
+  std::normal_distribution<double> g(0, 50);
+  for (int trial = 0; trial < 3000; ++trial) {
+    const int n = 3 + trial % 6;
+    std::vector<Vec2> pts;
+    for (int i = 0; i < n; ++i)
+      pts.push_back(trial % 2 ? Vec2(grid(rng), grid(rng)) : Vec2(g(rng), 0.3 * g(rng)));
+    Polygon few;
+    for (int i : convex_hull_indices(pts)) few.push_back(pts[i]);
+    std::vector<Vec2> padded = pts;
+    padded.resize(9, pts[0]);
+    Polygon chain;
+    for (int i : convex_hull_indices(padded)) chain.push_back(padded[i]);
+    ASSERT_EQ(few.size(), chain.size()) << "trial " << trial;
+    for (std::size_t i = 0; i < few.size(); ++i) ASSERT_EQ(few[i], chain[i]) << "trial " << trial << " vertex " << i;
+  }
+}
+
 double distance_to_polygon_boundary(const Polygon& poly, const Vec2& q) {
   double best = 1e300;
   for (std::size_t i = 0; i < poly.size(); ++i) {

@@ -51,7 +51,15 @@ struct ProjectionFlags {
     return behind_camera || sigma_point_behind_camera || rotation_too_uncertain ||
            unbounded || covariance_repaired;
   }
-  ProjectionFlags& operator|=(const ProjectionFlags& o);
+  // Inline: it runs for every vertex of every object, and a call cost more than the ors.
+  ProjectionFlags& operator|=(const ProjectionFlags& o) {
+    behind_camera |= o.behind_camera;
+    sigma_point_behind_camera |= o.sigma_point_behind_camera;
+    rotation_too_uncertain |= o.rotation_too_uncertain;
+    unbounded |= o.unbounded;
+    covariance_repaired |= o.covariance_repaired;
+    return *this;
+  }
 };
 
 struct ProjectedVertex {
