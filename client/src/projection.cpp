@@ -32,6 +32,11 @@ struct SigmaPoses {
   double wm0, wc0, wi;
 };
 
+// The columns xi_i = (rho, phi) of a square root S of the scaled covariance, component r
+// of column i at [r][i]: whole vectors of kLanes (the n = 6 columns and two zero columns).
+constexpr int kLanes = 8;
+using SigmaColumns = double[kN][kLanes];
+
 // The 2n sigma poses T * Exp(+-xi_i) for the columns xi_i = (rho, phi) of S, as
 // pose * se3_exp(+-xi) but all columns at once in loops that vectorise (vector_clones.hpp),
 // with one (a, b, c) per column for both signs and for both the rotation and the left
@@ -42,11 +47,8 @@ struct SigmaPoses {
 // Negating xi flips the a K term of R and the terms of V rho that are odd in xi.
 // Writes pose 1 + i = T Exp(xi_i) and pose 1 + n + i = T Exp(-xi_i).
 COVTRACK_VECTOR_CLONES
-void exp_sigma_poses(const Mat3& R0, const Vec3& t0, const Mat6& S, double (&out)[12][kSigmaPoints]) {
-  constexpr int kLanes = 8;  // the n = 6 columns and two zero columns: whole vectors
-  double rx[kLanes] = {}, ry[kLanes] = {}, rz[kLanes] = {}, px[kLanes] = {}, py[kLanes] = {}, pz[kLanes] = {};
-  for (int i = 0; i < kN; ++i)
-    rx[i] = S(0, i), ry[i] = S(1, i), rz[i] = S(2, i), px[i] = S(3, i), py[i] = S(4, i), pz[i] = S(5, i);
+void exp_sigma_poses(const Mat3& R0, const Vec3& t0, const SigmaColumns& S, double (&out)[12][kSigmaPoints]) {
+  const double *rx = S[0], *ry = S[1], *rz = S[2], *px = S[3], *py = S[4], *pz = S[5];
   double t2[kLanes], a[kLanes], b[kLanes], c[kLanes];
   for (int i = 0; i < kLanes; ++i) {
     // theta < 0.3 rad (sigma points of rotation sigmas up to 10 degrees): the Taylor series
@@ -103,7 +105,7 @@ void exp_sigma_poses(const Mat3& R0, const Vec3& t0, const Mat6& S, double (&out
 // Cholesky factor itself; the six square roots come at the end, side by side. False where
 // a pivot is not positive (or not a number). Written out: Eigen's general LLT took twice as
 // long on a 6x6, and there is one per object per frame.
-bool scaled_square_root6(const Mat6& A, double scale, Mat6& S) {
+bool scaled_square_root6(const Mat6& A, double scale, SigmaColumns& S) {
   double L[6][6], E[6][6], d[6];  // E = L D: column j of L times d_j
   for (int j = 0; j < 6; ++j) {
     double pivot = A(j, j);
@@ -120,8 +122,8 @@ bool scaled_square_root6(const Mat6& A, double scale, Mat6& S) {
   }
   double root[6];
   for (int j = 0; j < 6; ++j) root[j] = std::sqrt(scale * d[j]);
-  for (int j = 0; j < 6; ++j)
-    for (int i = 0; i < 6; ++i) S(i, j) = i < j ? 0.0 : i == j ? root[j] : L[i][j] * root[j];
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < kLanes; ++j) S[i][j] = j > i || j >= 6 ? 0.0 : i == j ? root[j] : L[i][j] * root[j];
   return true;
 }
 
@@ -129,10 +131,12 @@ SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut
   const double lambda = ut.alpha * ut.alpha * (kN + ut.kappa) - kN;
   // The Cholesky factor is the cheap square root; a singular covariance (a degree of
   // freedom known exactly) needs the eigen decomposition.
-  Mat6 S;
+  SigmaColumns S;
   if (!scaled_square_root6(pose.covariance, kN + lambda, S)) {
     Eigen::SelfAdjointEigenSolver<Mat6> eig((kN + lambda) * pose.covariance);
-    S = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+    const Mat6 root = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+    for (int i = 0; i < kN; ++i)
+      for (int j = 0; j < kLanes; ++j) S[i][j] = j < kN ? root(i, j) : 0.0;
   }
   const Mat3 R = pose.T.linear();
   const Vec3 t = pose.T.translation();
