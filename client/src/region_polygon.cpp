@@ -15,8 +15,9 @@ double cross(const Vec2& o, const Vec2& a, const Vec2& b) {
 // Up to this many points (an object's box) take the hull by successors below.
 constexpr int kFewPoints = 8;
 
-// Vectors of 4 (AVX2 registers; two SSE registers in the baseline clone). GCC 12 splits
-// comparisons of 8-wide vectors into scalars, even with AVX-512.
+// Vectors of 4 (AVX2 registers). GCC 12 splits comparisons of vectors wider than the
+// clone's registers into scalars: of 8 even with AVX-512, of 4 in the baseline clone (which
+// therefore sorts instead, see convex_hull_indices). Of 2 it was 5% slower with AVX2.
 using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
 using Mask = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
 constexpr int kGroups = kFewPoints / 4;
@@ -82,7 +83,7 @@ bool few_points_hull(std::span<const Vec2> p, std::vector<int>& h) {
 
 void convex_hull_indices(std::span<const Vec2> p, std::vector<int>& h) {
   const int n = static_cast<int>(p.size());
-  if (n >= 3 && n <= kFewPoints && few_points_hull(p, h)) return;
+  if (n >= 3 && n <= kFewPoints && vector_clones_have_avx2() && few_points_hull(p, h)) return;
   thread_local std::vector<int> idx;  // kept per thread: no allocation per object
   idx.resize(n);
   std::iota(idx.begin(), idx.end(), 0);
