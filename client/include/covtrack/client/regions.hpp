@@ -45,7 +45,9 @@ namespace covtrack::client {
 using Polygon = std::vector<Vec2>;
 
 // ---- Polygons (region_polygon.cpp) ----
-// Andrew's monotone chain; collinear points dropped. Indices into `points`.
+// Counter-clockwise from the lowest x (of those, the lowest y); collinear points dropped.
+// Andrew's monotone chain, or for up to 8 points on a CPU with AVX2 each point's successor
+// found side by side (the same hull, without a sort). Indices into `points`.
 std::vector<int> convex_hull_indices(std::span<const Vec2> points);
 // The same into `hull` (no allocation once its capacity suffices).
 void convex_hull_indices(std::span<const Vec2> points, std::vector<int>& hull);
