@@ -115,9 +115,9 @@ TEST(ConvexHull, PrefilteredHullEqualsPlainMonotoneChain) {
 
 // Up to 8 points (an object's box) the hull is taken by successors without a sort where the
 // CPU has AVX2 (vector_clones.hpp; elsewhere both sides below sort); more points take the
-// monotone chain. Copies of point 0 appended up to 9 points leave the hull as it
-// is, so each few-point hull is compared with the chain's. Points on a small grid repeat and
-// line up often; Gaussian points are in general position.
+// monotone chain. Copies of point 0 appended up to 9 points leave the hull as it is, so
+// each few-point hull is compared with the chain's. Points on a small grid repeat and line
+// up often; Gaussian points are in general position.
 TEST(ConvexHull, FewPointsGiveTheMonotoneChainsHull) {
   std::mt19937_64 rng(4);
   std::uniform_int_distribution<int> grid(0, 3);
