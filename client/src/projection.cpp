@@ -123,7 +123,7 @@ bool scaled_square_root6(const Mat6& A, double scale, SigmaColumns& S) {
   double root[6];
   for (int j = 0; j < 6; ++j) root[j] = std::sqrt(scale * d[j]);
   for (int i = 0; i < 6; ++i)
-    for (int j = 0; j < kLanes; ++j) S[i][j] = j > i || j >= 6 ? 0.0 : i == j ? root[j] : L[i][j] * root[j];
+    for (int j = 0; j < kLanes; ++j) S[i][j] = j > i ? 0.0 : i == j ? root[j] : L[i][j] * root[j];
   return true;
 }
 

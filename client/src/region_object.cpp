@@ -43,10 +43,10 @@ void compute_object_regions(const Camera& camera, const UncertainPose& T_camera_
   // (region_tangents.hpp).
   thread_local std::vector<TangentLine> inner_lines, outer_lines;
   outer_lines.clear();  // stays empty without the shortcut
-  hull_tangents(hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return hull[i]; },
-                std::pow(confidence_scale(o.regions.confidence), 2), &inner_lines,
-                o.regions.outer_by_arcs ? &outer_lines : nullptr);
-  expand_region(r.vertices, r.hull, outer_lines, o.regions, r.outer);
+  const double s2 = std::pow(confidence_scale(o.regions.confidence), 2);
+  hull_tangents(hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return hull[i]; }, s2,
+                &inner_lines, o.regions.outer_by_arcs ? &outer_lines : nullptr);
+  expand_region(r.vertices, r.hull, outer_lines, s2, o.regions, r.outer);
   contract_region(hull, inner_lines, r.inner);
   r.assessment = assess(o.assessment, hull);
   hull_pool = std::move(hull);

@@ -44,10 +44,9 @@ class Ellipses {
     for (auto* column : {&cu_, &cv_, &sxx_, &sxy_, &syy_, &h_}) column->resize(padded);
     for (std::size_t i = 0; i < padded; ++i) {
       const ProjectedVertex& v = vertices[i < n ? i : 0];
-      const Mat2& C = v.covariance_px2;
+      const Vec3 S = confidence_shape(v.covariance_px2, scale2);
       cu_[i] = v.mean_px.x(), cv_[i] = v.mean_px.y();
-      sxx_[i] = scale2 * C(0, 0), sxy_[i] = scale2 * 0.5 * (C(0, 1) + C(1, 0));
-      syy_[i] = scale2 * C(1, 1);
+      sxx_[i] = S[0], sxy_[i] = S[1], syy_[i] = S[2];
     }
   }
 
@@ -146,8 +145,10 @@ struct ArcLine {
   std::size_t ellipse;  // of the arc this line starts or lies in
 };
 
-// An arc's directions after one halving (middle) and two (quarter, three quarters).
-struct ArcSplits {
+// How an arc is split: how many times its angle is halved, and its directions after one
+// halving (middle) and two (quarter, three quarters).
+struct ArcPlan {
+  int halvings;
   Vec2 middle, quarter, three_quarters;
 };
 
@@ -167,20 +168,21 @@ struct ShortcutLines {
   std::size_t size() const { return count; }
   std::size_t padded() const { return (count + kVector - 1) / kVector * kVector; }
   // The arc of `ellipse` from `start` (a common tangent: normal, offset) towards the normal
-  // `end` in 2^halvings directions, uniform in angle: lines count .. count + 2^halvings - 1.
-  // The offsets of all but the first are -infinity: supports of their own ellipse, filled
-  // in by close_with_supports. Up to two halvings take their directions from `splits`
-  // (block_halvings). False when full.
-  bool add_arc(const Ellipses& ellipses, const ArcLine& start, const Vec2& end, int halvings, const ArcSplits& splits) {
+  // `end` in 2^h directions (h = plan.halvings), uniform in angle: lines count .. count +
+  // 2^h - 1. The offsets of all but the first are -infinity: supports of their own ellipse,
+  // filled in by close_with_supports. Up to two halvings take their directions from the
+  // plan (block_halvings). False when full.
+  bool add_arc(const Ellipses& ellipses, const ArcLine& start, const Vec2& end, const ArcPlan& plan) {
+    const int halvings = plan.halvings;
     const std::size_t n = std::size_t{1} << halvings, p = count;
     if (p + n > kMost) return false;
     double *x = nx + p, *y = ny + p;
     if (halvings <= 2) {
       x[0] = start.normal.x(), y[0] = start.normal.y();
-      if (halvings == 1) x[1] = splits.middle.x(), y[1] = splits.middle.y();
+      if (halvings == 1) x[1] = plan.middle.x(), y[1] = plan.middle.y();
       if (halvings == 2) {
-        x[1] = splits.quarter.x(), y[1] = splits.quarter.y(), x[2] = splits.middle.x(), y[2] = splits.middle.y();
-        x[3] = splits.three_quarters.x(), y[3] = splits.three_quarters.y();
+        x[1] = plan.quarter.x(), y[1] = plan.quarter.y(), x[2] = plan.middle.x(), y[2] = plan.middle.y();
+        x[3] = plan.three_quarters.x(), y[3] = plan.three_quarters.y();
       }
       return fill_arc(ellipses, start, n);
     }
@@ -257,7 +259,7 @@ bool corners_within(ShortcutLines& lines, double tol) {
 
 // A block of arcs side by side (see arc_halvings): start and end normals, the shape of the
 // ellipse (xx, xy, yy); out, the count of halvings found and the directions of the first two
-// (ArcSplits).
+// (ArcPlan).
 constexpr int kArcs = 8;
 struct ArcBlock {
   double sx[kArcs], sy[kArcs], ex[kArcs], ey[kArcs], xx[kArcs], xy[kArcs], yy[kArcs];
@@ -313,15 +315,13 @@ void block_halvings(ArcBlock& arcs, double tol) {
   }
 }
 
-// How many times each arc's angle is halved (see expand_by_arcs): arc i runs from the
-// normal of tangents[i] to that of the next, on tangents[i]'s ellipse. False where an arc
-// turns clockwise or by about pi, or needs more than `most` halvings (a sharp or
-// degenerate ellipse).
-bool arc_halvings(const Ellipses& ellipses, std::span<const ArcLine> tangents, double tol, int most,
-                  std::vector<int>& halvings, std::vector<ArcSplits>& splits) {
+// How each arc is split (see expand_by_arcs): arc i runs from the normal of tangents[i] to
+// that of the next, on tangents[i]'s ellipse. False where an arc turns clockwise or by
+// about pi, or needs more than `most` halvings (a sharp or degenerate ellipse).
+bool plan_arcs(const Ellipses& ellipses, std::span<const ArcLine> tangents, double tol, int most,
+               std::vector<ArcPlan>& plans) {
   const std::size_t k = tangents.size();
-  halvings.resize(k);
-  splits.resize(k);
+  plans.resize(k);
   ArcBlock arcs;
   for (std::size_t first = 0; first < k; first += kArcs) {
     const int count = static_cast<int>(std::min<std::size_t>(kArcs, k - first));
@@ -336,8 +336,8 @@ bool arc_halvings(const Ellipses& ellipses, std::span<const ArcLine> tangents, d
     block_halvings(arcs, tol);
     for (int j = 0; j < count; ++j) {
       if (arcs.halvings[j] > most) return false;
-      halvings[first + j] = static_cast<int>(arcs.halvings[j]);
-      splits[first + j] = {Vec2(arcs.mx[j], arcs.my[j]), Vec2(arcs.q1x[j], arcs.q1y[j]), Vec2(arcs.q3x[j], arcs.q3y[j])};
+      plans[first + j] = {static_cast<int>(arcs.halvings[j]), Vec2(arcs.mx[j], arcs.my[j]),
+                          Vec2(arcs.q1x[j], arcs.q1y[j]), Vec2(arcs.q3x[j], arcs.q3y[j])};
     }
   }
   return true;
@@ -409,13 +409,12 @@ ArcsResult arcs_polygon(Ellipses& ellipses, std::span<const int> hull, std::span
     if (!solved[i].solved) return ArcsResult::failed;
     tangents[i] = {solved[i].normal, solved[i].offset, static_cast<std::size_t>(hull[(i + 1) % k])};
   }
-  thread_local std::vector<int> halvings;
-  thread_local std::vector<ArcSplits> splits;
-  if (!arc_halvings(ellipses, tangents, tol, kMostHalvings, halvings, splits)) return ArcsResult::failed;
+  thread_local std::vector<ArcPlan> plans;
+  if (!plan_arcs(ellipses, tangents, tol, kMostHalvings, plans)) return ArcsResult::failed;
   thread_local ShortcutLines lines;
   lines.count = 0;
   for (std::size_t i = 0; i < k; ++i)
-    if (!lines.add_arc(ellipses, tangents[i], tangents[i + 1 == k ? 0 : i + 1].normal, halvings[i], splits[i])) return ArcsResult::failed;
+    if (!lines.add_arc(ellipses, tangents[i], tangents[i + 1 == k ? 0 : i + 1].normal, plans[i])) return ArcsResult::failed;
   if (static_cast<int>(lines.size()) > o.max_outer_corners) return ArcsResult::failed;
   close_with_supports(lines);
   // Every line a support of the whole set (to rounding), every corner within the tolerance
@@ -466,10 +465,10 @@ bool expand_by_arcs(Ellipses& ellipses, std::span<const ProjectedVertex> vertice
 // supports' loop is compiled for the clone's instructions too.
 [[gnu::flatten]] COVTRACK_VECTOR_CLONES
 void expand_region(std::span<const ProjectedVertex> vertices, std::span<const int> mean_hull,
-                   std::span<const TangentLine> outer_lines, const RegionOptions& o, Polygon& outer) {
+                   std::span<const TangentLine> outer_lines, double s2, const RegionOptions& o,
+                   Polygon& outer) {
   outer.clear();
   if (vertices.empty()) return;
-  const double s2 = std::pow(confidence_scale(o.confidence), 2);
   thread_local Ellipses ellipses;
   ellipses.assign(vertices, s2);
   if (o.outer_by_arcs && expand_by_arcs(ellipses, vertices, s2, mean_hull, outer_lines, o, outer)) return;
@@ -521,10 +520,11 @@ void expand_region(std::span<const ProjectedVertex> vertices, std::span<const in
   // The shortcut starts from the outer lines of the mean hull's edges (region_tangents.hpp).
   thread_local std::vector<TangentLine> lines;
   lines.clear();  // stays empty without the shortcut
+  const double s2 = std::pow(confidence_scale(o.confidence), 2);
   if (o.outer_by_arcs)
     hull_tangents(mean_hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return vertices[mean_hull[i]]; },
-                  std::pow(confidence_scale(o.confidence), 2), nullptr, &lines);
-  expand_region(vertices, mean_hull, lines, o, outer);
+                  s2, nullptr, &lines);
+  expand_region(vertices, mean_hull, lines, s2, o, outer);
 }
 
 void expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& o,

@@ -119,26 +119,24 @@ void common_tangents(TangentBlock& block) {
 
 namespace {
 
-constexpr std::size_t kHalf = kTangentLanes / 2;
-
 // Half `half` of a block's lanes (0 or 1) from the ellipses of the edges first ..
-// first + kHalf - 1 on one side. Copies of a constant 8 doubles are whole vectors.
+// first + kTangentHalf - 1 on one side. Copies of a constant 8 doubles are whole vectors.
 void fill_half(TangentBlock& block, int half, const HullEllipses& e, std::size_t first, TangentSide side) {
   const auto copy = [&](double* lanes, const std::vector<double>& column, std::size_t from) {
-    std::memcpy(lanes + half * kHalf, column.data() + from, kHalf * sizeof(double));
+    std::memcpy(lanes + half * kTangentHalf, column.data() + from, kTangentHalf * sizeof(double));
   };
   copy(block.au, e.u, first), copy(block.bu, e.u, first + 1);
   copy(block.av, e.v, first), copy(block.bv, e.v, first + 1);
   copy(block.axx, e.xx, first), copy(block.bxx, e.xx, first + 1);
   copy(block.axy, e.xy, first), copy(block.bxy, e.xy, first + 1);
   copy(block.ayy, e.yy, first), copy(block.byy, e.yy, first + 1);
-  std::fill_n(block.side + half * kHalf, kHalf, side == TangentSide::inner ? -1.0 : 1.0);
+  std::fill_n(block.side + half * kTangentHalf, kTangentHalf, side == TangentSide::inner ? -1.0 : 1.0);
 }
 
 }  // namespace
 
-// The work goes in halves of a block: kHalf edges of one side. Two halves per block, so
-// that an object of up to kHalf edges has both its sides in one block (an odd half out is
+// The work goes in halves of a block: kTangentHalf edges of one side. Two halves per block, so
+// that an object of up to kTangentHalf edges has both its sides in one block (an odd half out is
 // solved twice). Past the k edges a half's lanes hold edges again from the start (the
 // ellipses repeat cyclically): real pairs, solved and not used.
 COVTRACK_VECTOR_CLONES  // the copies in whole vectors
@@ -154,7 +152,7 @@ void hull_tangents(const HullEllipses& e, std::vector<TangentLine>* inner, std::
   for (auto [lines, side] : {std::pair{inner, TangentSide::inner}, std::pair{outer, TangentSide::outer}}) {
     if (!lines) continue;
     lines->resize(k);
-    for (std::size_t first = 0; first < k; first += kHalf) halves.push_back({lines, side, first});
+    for (std::size_t first = 0; first < k; first += kTangentHalf) halves.push_back({lines, side, first});
   }
   TangentBlock block;
   for (std::size_t h = 0; h < halves.size(); h += 2) {
@@ -163,7 +161,7 @@ void hull_tangents(const HullEllipses& e, std::vector<TangentLine>* inner, std::
     common_tangents(block);
     for (int half = 0; half < 2; ++half) {
       const Half& w = *pair[half];
-      for (std::size_t j = 0, lane = half * kHalf; j < kHalf && w.first + j < k; ++j, ++lane)
+      for (std::size_t j = 0, lane = half * kTangentHalf; j < kTangentHalf && w.first + j < k; ++j, ++lane)
         (*w.lines)[w.first + j] = {Vec2(block.nu[lane], block.nv[lane]), block.offset[lane], block.solved[lane] != 0};
     }
   }

@@ -12,8 +12,15 @@ namespace covtrack::client {
 enum class TangentSide { inner, outer };
 
 // Pairs solved at once: two vectors of 8 with AVX-512, one object's inner and outer lines
-// (up to 8 edges) in one call.
+// (up to 8 edges) in one call; a half holds one side's edges.
 constexpr int kTangentLanes = 16;
+constexpr std::size_t kTangentHalf = kTangentLanes / 2;
+
+// A projected vertex's confidence ellipse shape: scale2 (the confidence scale squared) times
+// its covariance, made symmetric: xx, xy, yy.
+inline Vec3 confidence_shape(const Mat2& C, double scale2) {
+  return {scale2 * C(0, 0), scale2 * 0.5 * (C(0, 1) + C(1, 0)), scale2 * C(1, 1)};
+}
 
 struct TangentBlock {
   // Inputs per pair (ellipse a, then b counter-clockwise): centres and shapes (the
@@ -64,16 +71,15 @@ void hull_tangents(std::size_t k, HullVertex vertex, double scale2, std::vector<
     return;
   }
   thread_local HullEllipses e;  // kept per thread: no allocation per object
-  // Whole halves of blocks (kTangentLanes / 2 edges), and the last edge's end.
-  constexpr std::size_t kHalf = kTangentLanes / 2;
-  const std::size_t entries = (k + kHalf - 1) / kHalf * kHalf + 1;
+  // Whole halves of blocks, and the last edge's end.
+  const std::size_t entries = (k + kTangentHalf - 1) / kTangentHalf * kTangentHalf + 1;
   e.k = k;
   for (auto* column : {&e.u, &e.v, &e.xx, &e.xy, &e.yy}) column->resize(entries);
   for (std::size_t i = 0, vi = 0; i < entries; ++i, vi = vi + 1 == k ? 0 : vi + 1) {
     const ProjectedVertex& p = vertex(vi);
-    const Mat2& C = p.covariance_px2;
+    const Vec3 S = confidence_shape(p.covariance_px2, scale2);
     e.u[i] = p.mean_px.x(), e.v[i] = p.mean_px.y();
-    e.xx[i] = scale2 * C(0, 0), e.xy[i] = scale2 * 0.5 * (C(0, 1) + C(1, 0)), e.yy[i] = scale2 * C(1, 1);
+    e.xx[i] = S[0], e.xy[i] = S[1], e.yy[i] = S[2];
   }
   hull_tangents(e, inner, outer);
 }

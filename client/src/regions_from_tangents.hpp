@@ -11,8 +11,10 @@ namespace covtrack::client {
 void contract_region(std::span<const ProjectedVertex> hull, std::span<const TangentLine> inner_lines,
                      Polygon& inner);
 
-// expand_region, from the mean hull's outer lines (empty: none solved, so the search).
+// expand_region, from the mean hull's outer lines (empty: none solved, so the search),
+// solved with the confidence scale squared `s2` (the ellipses here take the same).
 void expand_region(std::span<const ProjectedVertex> vertices, std::span<const int> mean_hull,
-                   std::span<const TangentLine> outer_lines, const RegionOptions& o, Polygon& outer);
+                   std::span<const TangentLine> outer_lines, double s2, const RegionOptions& o,
+                   Polygon& outer);
 
 }  // namespace covtrack::client
