@@ -99,7 +99,7 @@ calibration = ")" COVTRACK_SOURCE_DIR R"(/config/cameras/rendered_640x480.yml"
 id = 0
 size_m = 0.1
 )",
-                  "cannot open video source '/nonexistent/covtrack/video.avi'"},
+                  "video file '/nonexistent/covtrack/video.avi' does not exist"},
         BadDevice{"fastrak_port_is_a_file", R"(
 [devices.bad]
 type = "fastrak"

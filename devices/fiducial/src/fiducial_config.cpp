@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "covtrack/devices/device_keys.hpp"
+#include "covtrack/devices/fiducial/frame_source.hpp"
 
 namespace covtrack::fiducial {
 
@@ -75,9 +76,6 @@ namespace {
 std::string relative_to_config(const std::string& path, const std::string& config_file) {
   if (path.empty() || std::filesystem::path(path).is_absolute()) return path;
   return (std::filesystem::path(config_file).parent_path() / path).string();
-}
-bool is_camera_index(const std::string& s) {
-  return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos;
 }
 }  // namespace
 

@@ -8,8 +8,8 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
+#include "covtrack/devices/fiducial/frame_source.hpp"
 #include "covtrack/devices/fiducial/raw_detection.hpp"
 #include "covtrack/devices/fiducial/tag_pose.hpp"
 #include "covtrack/devices/interruptible_sleep.hpp"
@@ -17,10 +17,6 @@
 
 namespace covtrack::fiducial {
 namespace {
-
-bool is_camera_index(const std::string& s) {
-  return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos;
-}
 
 class FiducialDriver final : public Driver {
  public:
@@ -35,21 +31,6 @@ class FiducialDriver final : public Driver {
   }
 
  private:
-  Result<void> open_source() {
-    const bool camera = is_camera_index(config_.source);
-    capture_ = std::make_unique<cv::VideoCapture>();
-    const bool opened = camera ? capture_->open(std::stoi(config_.source), cv::CAP_V4L2)
-                               : capture_->open(config_.source);
-    if (!opened || !capture_->isOpened())
-      return fail(camera ? fmt::format("cannot open camera {} (V4L2 /dev/video{})", config_.source,
-                                       config_.source)
-                         : fmt::format("cannot open video source '{}' (no such file, or not a "
-                                       "video / image sequence OpenCV can read)",
-                                       config_.source));
-    is_camera_ = camera;
-    return {};
-  }
-
   Result<void> run_checked(SampleSink& sink, std::stop_token stop) {
     auto camera = load_camera_model(config_.calibration);
     if (!camera) return std::unexpected(camera.error());
@@ -57,32 +38,32 @@ class FiducialDriver final : public Driver {
     auto detector = TagDetector::create(config_.detector);
     if (!detector) return std::unexpected(detector.error());
     detector_ = std::move(*detector);
-    if (auto opened = open_source(); !opened) return opened;
+    auto source = open_frame_source(config_.source, config_.loop);
+    if (!source) return std::unexpected(source.error());
 
     using namespace std::chrono;
+    const bool paced = !(*source)->is_camera() && config_.rate_hz > 0;
+    const auto period = paced ? duration_cast<steady_clock::duration>(duration<double>(1.0 / config_.rate_hz))
+                              : steady_clock::duration::zero();
     auto next = steady_clock::now();
-    std::uint64_t frames_in_pass = 0;
-    cv::Mat frame, gray;
+    cv::Mat gray;
     for (std::uint32_t index = 0; !stop.stop_requested(); ++index) {
-      if (!is_camera_ && config_.rate_hz > 0) {
-        next += duration_cast<steady_clock::duration>(duration<double>(1.0 / config_.rate_hz));
+      if (paced) {
+        next += period;
         if (!sleep_until(stop, next)) return {};
       }
-      if (!capture_->read(frame) || frame.empty()) {
-        if (is_camera_) return fail(fmt::format("camera {} stopped delivering frames", config_.source));
-        if (frames_in_pass == 0)
-          return fail(fmt::format("'{}': no frame could be decoded (corrupt or empty video)",
-                                  config_.source));
-        if (!config_.loop) {
-          sleep_for(stop, milliseconds(50));  // idle until stopped
-          --index;
-          continue;
-        }
-        if (auto reopened = open_source(); !reopened) return reopened;
-        frames_in_pass = 0;
+      auto read = (*source)->next();
+      if (!read) return std::unexpected(read.error());
+      if (read->kind == FrameRead::Kind::End) {  // a file source played once: idle until stopped
+        while (sleep_for(stop, milliseconds(50))) {}
+        return {};
+      }
+      if (read->kind == FrameRead::Kind::Damaged) {
+        // Skipped, keeping its frame period, so the frames after it keep their pace.
+        sink.count_error(fmt::format("damaged frame '{}': {}; skipped", read->name, read->problem));
         continue;
       }
-      ++frames_in_pass;
+      const cv::Mat& frame = read->image;
       const std::int64_t time_us = now_us();
       if (frame.channels() == 3) cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
       else if (frame.channels() == 4) cv::cvtColor(frame, gray, cv::COLOR_BGRA2GRAY);
@@ -90,8 +71,8 @@ class FiducialDriver final : public Driver {
       if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
       if (gray.cols != camera_.width_px || gray.rows != camera_.height_px)
         return fail(fmt::format("'{}': frame is {}x{} but the calibration '{}' is for {}x{}",
-                                config_.source, gray.cols, gray.rows, config_.calibration,
-                                camera_.width_px, camera_.height_px));
+                                read->name.empty() ? config_.source : read->name, gray.cols,
+                                gray.rows, config_.calibration, camera_.width_px, camera_.height_px));
       process(sink, gray, index, time_us);
       if (config_.publish_images && frames_published_++ % std::max(1, config_.image_every_n) == 0)
         publish_image(sink, frame, time_us);
@@ -158,8 +139,6 @@ class FiducialDriver final : public Driver {
   FiducialConfig config_;
   CameraModel camera_;
   std::unique_ptr<TagDetector> detector_;
-  std::unique_ptr<cv::VideoCapture> capture_;
-  bool is_camera_ = false;
   std::uint64_t frames_published_ = 0;  // frames considered for publish_images (every n-th goes)
   std::map<int, Pose> last_pose_;
 };
