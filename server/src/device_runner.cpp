@@ -34,8 +34,13 @@ class DeviceRunner::Sink final : public SampleSink {
   }
   void count_error(const std::string& what) override {
     ++r_.errors_;
-    std::lock_guard lock(r_.last_error_mutex_);
+    std::lock_guard lock(r_.text_mutex_);
     r_.last_error_ = what;
+  }
+  void running(const std::string& detail) override {
+    r_.state_ = device_status_t::STATE_RUNNING;
+    std::lock_guard lock(r_.text_mutex_);
+    r_.detail_ = detail;
   }
   void count_resync() override { ++r_.resyncs_; }
   void count_drop() override { ++r_.drops_; }
@@ -65,8 +70,9 @@ void DeviceRunner::join() {
 void DeviceRunner::record_failure(const std::string& message) {
   ++errors_;
   state_ = device_status_t::STATE_FAILED;
-  std::lock_guard lock(last_error_mutex_);
+  std::lock_guard lock(text_mutex_);
   last_error_ = message;
+  detail_.clear();  // it described the run that failed
 }
 
 void DeviceRunner::supervise(std::stop_token stop) {
@@ -117,8 +123,9 @@ device_status_t DeviceRunner::heartbeat() {
   s.drops = drops_;
   s.restarts = restarts_;
   {
-    std::lock_guard lock(last_error_mutex_);
+    std::lock_guard lock(text_mutex_);
     s.last_error = last_error_;
+    s.detail = detail_;
   }
   reports_at_last_heartbeat_ = reports;
   last_heartbeat_ = now;

@@ -39,8 +39,9 @@ class DeviceRunner {
 
   std::atomic<std::int8_t> state_{device_status_t::STATE_STARTING};
   std::atomic<std::int64_t> reports_{0}, errors_{0}, resyncs_{0}, drops_{0}, restarts_{0};
-  std::mutex last_error_mutex_;
+  std::mutex text_mutex_;  // guards the two texts below
   std::string last_error_;
+  std::string detail_;  // SampleSink::running's, cleared when the driver fails
 
   std::int64_t reports_at_last_heartbeat_ = 0;
   std::chrono::steady_clock::time_point last_heartbeat_ = std::chrono::steady_clock::now();

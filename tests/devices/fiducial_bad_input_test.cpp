@@ -1,7 +1,8 @@
 // The fiducial driver on bad input, with real rendered frames and real files: a cut
 // JPEG or PNG in an image sequence is reported by name and skipped while the frames
-// around it are processed; a looped sequence runs at its configured rate, counted from
-// the frames' own timestamps.
+// around it are processed; a camera that sees no tag says so instead of looking as if it
+// never started; a looped sequence runs at its configured rate, counted from the frames'
+// own timestamps.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -38,6 +39,9 @@ class EventSink : public SampleSink {
     ASSERT_TRUE(frame.has_value());
     add([&] { frames.push_back(*frame); });
   }
+  void running(const std::string& detail) override {
+    add([&] { if (details.empty() || details.back() != detail) details.push_back(detail); });
+  }
   void count_error(const std::string& what) override { add([&] { errors.push_back(what); }); }
   void count_resync() override {}
   void count_drop() override {}
@@ -53,7 +57,7 @@ class EventSink : public SampleSink {
   std::condition_variable cv;
   std::vector<PoseSample> poses;
   std::vector<RawFrame> frames;
-  std::vector<std::string> errors;
+  std::vector<std::string> details, errors;
 
  private:
   template <typename F>
@@ -159,6 +163,24 @@ TEST_P(DamagedFrame, IsNamedAndSkippedAndTheFramesAroundItAreProcessed) {
 
 INSTANTIATE_TEST_SUITE_P(JpegAndPng, DamagedFrame, ::testing::Values(".jpg", ".png"),
                          [](const auto& info) { return info.param.substr(1); });
+
+// Frames without tags, then one with a tag outside the map, then the mapped tags: the
+// detail follows what the camera sees, and is cleared once a mapped tag is posed.
+TEST(NoTagInView, IsReportedAsRunningWithADetail) {
+  const fs::path dir = fresh_dir("notag");
+  const RenderedTag unmapped{5, 0.1, test::tag_pose(0.9, 10, 0, 0)};
+  const fs::path pattern = write_frames(dir, ".png", {{}, {}, {unmapped}, kTags});
+  EventSink sink;
+  RunningDriver driver(config_for(pattern), sink);
+  const bool done = sink.wait_for([&] { return sink.frames.size() == 4; });
+  auto result = driver.stop();
+  ASSERT_TRUE(result.has_value()) << result.error().message;
+  ASSERT_TRUE(done);
+  const std::vector<std::string> expected = {"no tag in view",
+                                             "no mapped tag in view (seen, not in the tag map: 5)", ""};
+  EXPECT_EQ(sink.details, expected);
+  EXPECT_TRUE(sink.errors.empty());
+}
 
 // One still frame looped at 20 Hz: 40 frame periods must span 2 s of the frames' own
 // measurement times. (Starting over used to cost a period: every other period was

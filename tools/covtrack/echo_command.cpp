@@ -108,8 +108,9 @@ std::string table(const client::Subscriber& sub, RateMeter& rates) {
   out += "σ: 1-sigma along the worst direction (sqrt of the largest eigenvalue of the 3x3 "
          "position / rotation block, BODY frame); stale times: how often it went stale\n";
   for (const auto& [device, st] : sub.device_statuses())
-    out += fmt::format("device {:<20} {:>7.1f} Hz reports {:>9} errors {:>4} drops {:>4} restarts {:>3}{}\n",
+    out += fmt::format("device {:<20} {:>7.1f} Hz reports {:>9} errors {:>4} drops {:>4} restarts {:>3}{}{}\n",
                        device, st.rate_hz, st.reports, st.errors, st.drops, st.restarts,
+                       st.detail.empty() ? "" : "  (" + st.detail + ")",
                        st.last_error.empty() ? "" : "  last error: " + st.last_error);
   return out;
 }

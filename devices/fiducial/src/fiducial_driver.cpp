@@ -6,6 +6,7 @@
 #include <set>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -17,6 +18,15 @@
 
 namespace covtrack::fiducial {
 namespace {
+
+// What the device status says beside RUNNING: nothing while a tag of the map is in
+// view; otherwise that the camera works but sees none, and which other tags it sees (a
+// wrong family or tag map shows here).
+std::string view_detail(const std::set<int>& mapped, const std::set<int>& unmapped) {
+  if (!mapped.empty()) return {};
+  if (unmapped.empty()) return "no tag in view";
+  return fmt::format("no mapped tag in view (seen, not in the tag map: {})", fmt::join(unmapped, ", "));
+}
 
 class FiducialDriver final : public Driver {
  public:
@@ -82,9 +92,10 @@ class FiducialDriver final : public Driver {
 
   void process(SampleSink& sink, const cv::Mat& gray, std::uint32_t index, std::int64_t time_us) {
     RawFrame raw{index, time_us, estimate_image_noise(gray), {}};
-    std::set<int> seen;
+    std::set<int> seen, mapped, unmapped;  // seen: posed
     for (const Detection& det : detector_->detect(gray)) {
       const auto size = config_.tag_size_m.find(det.id);
+      (size == config_.tag_size_m.end() ? unmapped : mapped).insert(det.id);
       if (size == config_.tag_size_m.end() || seen.count(det.id)) continue;
       const CornerInputs inputs = measure_corner_inputs(gray, det, detector_->family(), raw.image_noise);
       const CornerNoise noise = config_.noise.noise(inputs);
@@ -116,6 +127,7 @@ class FiducialDriver final : public Driver {
       s.status = TrackingStatus::Lost;
       sink.pose(s);
     }
+    sink.running(view_detail(mapped, unmapped));
     if (config_.publish_raw) {
       const auto bytes = encode_raw_frame(raw);
       sink.raw(ByteDirection::FromDevice, bytes.data(), bytes.size());

@@ -53,6 +53,11 @@ class SampleSink {
   virtual void raw(ByteDirection direction, const std::uint8_t* data, std::size_t size) = 0;
   // Camera frames are optional: a sink that has no use for them drops them.
   virtual void image(const ImageSample&) {}
+  // The device works but what it sees is worth a word, e.g. "no tag in view": a camera
+  // that delivers frames without a tag sends no pose, and would otherwise look as if it
+  // never started. The daemon shows the device RUNNING with this detail; an empty
+  // detail clears it. Poses need no call: they mark the device RUNNING themselves.
+  virtual void running(const std::string& /*detail*/) {}
   // Bad frames skipped by a decoder, resynchronisations, data the driver had to drop.
   virtual void count_error(const std::string& what) = 0;
   virtual void count_resync() = 0;
