@@ -95,7 +95,8 @@ void read_devices(TableReader& top, DaemonConfig& out) {
 
 }  // namespace
 
-Result<DaemonConfig> parse_config(std::string_view text, const std::string& source_name) {
+Result<DaemonConfig> parse_config(std::string_view text, const std::string& source_name,
+                                  ResourceChecks checks) {
   auto root = parse_toml(text, source_name);
   if (!root) return std::unexpected(root.error());
   ConfigErrors errors;
@@ -103,14 +104,15 @@ Result<DaemonConfig> parse_config(std::string_view text, const std::string& sour
   DaemonConfig out;
   out.daemon = read_daemon(top);
   read_devices(top, out);
+  if (checks == ResourceChecks::Run) errors.run_resource_checks();
   if (!errors.empty()) return fail(errors.joined());
   return out;
 }
 
-Result<DaemonConfig> load_config(const std::string& path) {
+Result<DaemonConfig> load_config(const std::string& path, ResourceChecks checks) {
   auto text = read_config_text(path);
   if (!text) return std::unexpected(text.error());
-  return parse_config(*text, path);
+  return parse_config(*text, path, checks);
 }
 
 std::string config_schema_markdown() {

@@ -26,10 +26,17 @@ struct DaemonConfig {
   std::vector<DeviceConfig> devices;  // enabled devices only
 };
 
+// What a config load checks beyond the config itself.
+enum class ResourceChecks {
+  Skip,  // at start: a missing device may appear later; its driver retries it
+  Run,   // --check: every file, folder and device node the devices name must open
+};
+
 // On failure the error holds every problem found, one per line, each as
 // file:line:column: key.path: what is wrong.
-Result<DaemonConfig> load_config(const std::string& path);
-Result<DaemonConfig> parse_config(std::string_view toml_text, const std::string& source_name);
+Result<DaemonConfig> load_config(const std::string& path, ResourceChecks checks = ResourceChecks::Skip);
+Result<DaemonConfig> parse_config(std::string_view toml_text, const std::string& source_name,
+                                  ResourceChecks checks = ResourceChecks::Skip);
 
 // The schema of every table the config can hold, as Markdown (config/schema.md).
 std::string config_schema_markdown();

@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   bool check_only = false, print_schema = false;
   app.add_option("--config,-c", config_path, "daemon config (TOML), e.g. config/sim.toml");
   app.add_option("--lcm-url", lcm_url, "LCM URL (overrides the config's daemon.lcm_url)");
-  app.add_flag("--check", check_only, "validate the config and exit");
+  app.add_flag("--check", check_only, "validate the config, open every file and device it names, and exit");
   app.add_flag("--print-schema", print_schema, "print the config schema (Markdown) and exit");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
@@ -49,7 +49,10 @@ int main(int argc, char** argv) {
     std::cerr << "covtrackd: --config FILE is required (try config/sim.toml)\n";
     return kExitBadConfig;
   }
-  auto config = covtrack::server::load_config(config_path);
+  // --check also opens what the devices name (files, folders, device nodes); a start
+  // does not, as a device missing now may appear later and its driver retries it.
+  auto config = covtrack::server::load_config(
+      config_path, check_only ? covtrack::server::ResourceChecks::Run : covtrack::server::ResourceChecks::Skip);
   if (!config) {
     std::cerr << "covtrackd: the config has errors; nothing was started:\n"
               << config.error().message;

@@ -35,6 +35,17 @@ std::string ConfigErrors::joined() const {
   return out;
 }
 
+void ConfigErrors::add_resource_check(const std::string& file, const toml::source_region& where,
+                                      const std::string& key_path, ResourceCheck check) {
+  checks_.push_back({file, where, key_path, std::move(check)});
+}
+
+void ConfigErrors::run_resource_checks() {
+  for (const PendingCheck& c : checks_)
+    if (auto ok = c.check(); !ok) add(c.file, c.where, c.key_path, ok.error().message);
+  checks_.clear();
+}
+
 TableReader::TableReader(const toml::table& table, std::string key_path, const TableSpec& spec,
                          std::string file, ConfigErrors& errors)
     : table_(table), key_path_(std::move(key_path)), spec_(spec), file_(std::move(file)),
@@ -60,6 +71,11 @@ const KeySpec* TableReader::spec_of(std::string_view key) {
 }
 
 bool TableReader::has(std::string_view key) const { return table_.contains(key); }
+
+void TableReader::resource(std::string_view key, ResourceCheck check) {
+  if (const toml::node* node = table_.get(key))
+    errors_.add_resource_check(file_, node->source(), path(key), std::move(check));
+}
 
 void TableReader::error(std::string_view key, const std::string& message) {
   const toml::node* node = table_.get(key);

@@ -13,8 +13,9 @@ const TableSpec& fiducial_device_spec() {
   static const TableSpec spec = [] {
     TableSpec s{"devices.<name> (type = \"fiducial\")", "fiducial driver", device_common_keys()};
     const std::vector<KeySpec> own = {
-        {"source", ValueType::String, "", "", "camera: V4L2 index (\"0\"); or a video file; or an "
-         "image sequence pattern (\"frames/frame_%04d.png\"); relative to this file"},
+        {"source", ValueType::String, "", "", "camera: V4L2 index (\"0\"); or image files: a "
+         "pattern (\"frames/frame_%04d.png\", numbered from 0 or 1) or one image; or a video file; "
+         "relative to this file; `covtrackd --check` opens it"},
         {"calibration", ValueType::String, "", "", "OpenCV calibration file (camera_matrix, "
          "distortion_coefficients, image_width, image_height); relative to this file"},
         {"family", ValueType::String, "", "\"tag36h11\"", "AprilTag family"},
@@ -85,6 +86,7 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
   c.parent_frame = r.string("parent_frame", "world");
   c.source = r.string("source");
   if (!is_camera_index(c.source)) c.source = relative_to_config(c.source, r.file());
+  r.resource("source", [source = c.source] { return check_frame_source(source); });
   c.calibration = relative_to_config(r.string("calibration"), r.file());
   c.detector.family = r.string("family", "tag36h11");
   bool known = false;

@@ -3,6 +3,7 @@
 // one error with file:line:column and the full key path; reading goes on so that a user
 // sees all of a config's mistakes at once. The same schema prints config/schema.md.
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -36,6 +37,11 @@ struct TableSpec {
   std::vector<KeySpec> keys;
 };
 
+// A check of something a config value names outside the config (a file, a folder, a
+// device node). Only `covtrackd --check` runs these: at start a device that is missing
+// may appear later, and its driver retries it with back-off, so it is no config error.
+using ResourceCheck = std::function<Result<void>()>;
+
 class ConfigErrors {
  public:
   void add(const std::string& file, const toml::source_region& where,
@@ -44,8 +50,20 @@ class ConfigErrors {
   const std::vector<std::string>& list() const { return errors_; }
   std::string joined() const;
 
+  void add_resource_check(const std::string& file, const toml::source_region& where,
+                          const std::string& key_path, ResourceCheck check);
+  // Runs the resource checks recorded so far; each failure becomes an error at its key.
+  void run_resource_checks();
+
  private:
+  struct PendingCheck {
+    std::string file;
+    toml::source_region where;
+    std::string key_path;
+    ResourceCheck check;
+  };
   std::vector<std::string> errors_;
+  std::vector<PendingCheck> checks_;
 };
 
 class TableReader {
@@ -73,6 +91,8 @@ class TableReader {
   // An array of tables ([[key]] in TOML): each element checked to be a table.
   std::vector<const toml::table*> tables(std::string_view key);
 
+  // Records `check` of the resource `key` names (see ResourceCheck); nothing if absent.
+  void resource(std::string_view key, ResourceCheck check);
   // Records a problem that only the caller can judge (e.g. two keys that conflict).
   void error(std::string_view key, const std::string& message);
   std::string path(std::string_view key) const;
