@@ -1,8 +1,12 @@
-// A small tag seen nearly face-on: the two poses that fit its corners are hard to tell
-// apart, and the reported covariance must cover both (and the truth).
+// Small tags seen nearly face-on: the two poses that fit their corners are hard to tell
+// apart. A pose reported OK must have its truth inside its 99% region (at most 1% may
+// not: the bar), and a pose flagged ambiguous must have a covariance that covers
+// both solutions. Views come from the held-out rasteriser and the corner model's camera
+// population, so the flip test is judged with the systematic corner terms in play.
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <random>
 
 #include "covtrack/devices/fiducial/noise_calibration.hpp"
 #include "covtrack/devices/fiducial/tag_pose.hpp"
@@ -11,48 +15,53 @@
 using namespace covtrack;
 using namespace covtrack::fiducial;
 
-TEST(FiducialAmbiguity, CovarianceCoversBothSolutionsOfASmallFaceOnTag) {
-  const CameraModel cam = test::small_camera();
-  CalibrationView v;
-  v.tag = {4, 0.06, test::tag_pose(0.7, 3, 2, 20)};
-  v.noise_sigma = 6;
+TEST(FiducialAmbiguity, OkPosesHoldTheirTruthAndAmbiguousOnesCoverBothSolutions) {
+  constexpr double kChi2_6_99 = 16.812;
+  const CornerNoiseModel model;  // the shipped defaults
   DetectorOptions o;
   o.decimate = 1;
-  auto draws = draw_view(cam, o, v, 100, 77);
-  ASSERT_TRUE(draws.has_value()) << draws.error().message;
-  const CornerNoiseModel model = test::calibrated_corner_model();
-  constexpr double kChi2_6_99 = 16.812;
-  int detected = 0, ambiguous = 0, truth_outside = 0, truth_outside_uninflated = 0;
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int detected = 0, ok = 0, ok_outside = 0, ambiguous = 0, ambiguous_outside = 0;
+  int plain_outside = 0;  // the same draws without the inflation
   double max_second_distance = 0;
-  for (const ViewDraw& d : *draws) {
-    if (!d.detection) continue;
-    ++detected;
-    const CornerNoise noise = corner_noise(model, d);
-    auto pose = estimate_tag_pose(cam, d.detection->corners_px, v.tag.size_m, noise);
-    ASSERT_TRUE(pose.has_value()) << pose.error().message;
-    const Vec6 e = boxminus(d.T_camera_tag_true, pose->best.T_camera_tag);
-    truth_outside += e.dot(pose->covariance.ldlt().solve(e)) > kChi2_6_99;
-    // The same without inflation: the first-order covariance of the chosen pose alone.
-    auto plain_pose = estimate_tag_pose(cam, d.detection->corners_px, v.tag.size_m, noise, 0.0);
-    ASSERT_TRUE(plain_pose.has_value());
-    const Mat6 plain = plain_pose->covariance;
-    truth_outside_uninflated += e.dot(plain.ldlt().solve(e)) > kChi2_6_99;
-    if (pose->ambiguous) {
-      ++ambiguous;
-      const Vec6 s = boxminus(pose->second->T_camera_tag, pose->best.T_camera_tag);
-      max_second_distance = std::max(max_second_distance, s.dot(pose->covariance.ldlt().solve(s)));
+  for (int view = 0; view < 12; ++view) {
+    CalibrationView v;
+    v.camera = test::camera(640, 480, 62);
+    v.formation = test::random_formation(rng, Rasteriser::AnalyticArea);
+    // 0.05-0.07 m at 0.6-0.9 m: 35-75 px across, turned by at most 5 degrees.
+    v.tag = {view, 0.06 + 0.01 * u(rng),
+             test::tag_pose(0.75 + 0.15 * u(rng), 5 * u(rng), 5 * u(rng), 180 * u(rng), 0.05 * u(rng),
+                            0.04 * u(rng))};
+    auto draws = draw_view(o, v, 25, 100 + static_cast<std::uint64_t>(view));
+    ASSERT_TRUE(draws.has_value()) << draws.error().message;
+    for (const ViewDraw& d : *draws) {
+      if (!d.detection) continue;
+      ++detected;
+      const CornerNoise noise = corner_noise(model, d);
+      auto pose = estimate_tag_pose(v.camera, d.detection->corners_px, v.tag.size_m, noise);
+      ASSERT_TRUE(pose.has_value()) << pose.error().message;
+      const Vec6 e = boxminus(d.T_camera_tag_true, pose->best.T_camera_tag);
+      const bool outside = e.dot(pose->covariance.ldlt().solve(e)) > kChi2_6_99;
+      auto plain = estimate_tag_pose(v.camera, d.detection->corners_px, v.tag.size_m, noise, 0.0);
+      ASSERT_TRUE(plain.has_value());
+      plain_outside += e.dot(plain->covariance.ldlt().solve(e)) > kChi2_6_99;
+      if (pose->ambiguous) {
+        ++ambiguous, ambiguous_outside += outside;
+        const Vec6 s = boxminus(pose->second->T_camera_tag, pose->best.T_camera_tag);
+        max_second_distance = std::max(max_second_distance, s.dot(pose->covariance.ldlt().solve(s)));
+      } else {
+        ++ok, ok_outside += outside;
+      }
     }
   }
-  std::printf("detected %d, ambiguous %d, truth outside the 99%% region: %d inflated, %d without "
-              "inflation; largest Mahalanobis^2 of the second pose %.2f\n",
-              detected, ambiguous, truth_outside, truth_outside_uninflated, max_second_distance);
-  EXPECT_GE(detected, 90);
-  EXPECT_GE(ambiguous, detected / 2) << "a small face-on tag must be flagged ambiguous";
+  std::printf("detected %d: OK %d (truth outside the 99%% region: %d), ambiguous %d (outside: %d); "
+              "without inflation %d outside; largest Mahalanobis^2 of a second pose %.2f\n",
+              detected, ok, ok_outside, ambiguous, ambiguous_outside, plain_outside, max_second_distance);
+  EXPECT_GE(detected, 12 * 25 * 9 / 10);
+  EXPECT_GE(ambiguous, detected / 4) << "small face-on tags must often be flagged ambiguous";
   EXPECT_LT(max_second_distance, kChi2_6_99) << "the second pose must lie inside the covariance";
-  // The bar: the truth inside the 99% region for at least 90% of the draws. This
-  // small tag's edges are pulled outward by the white cells inside its thin border
-  // (0.02-0.12 px, a constant of the view); the edge-shift correction removes that
-  // (devices/fiducial/README.md, "Corner noise model").
-  EXPECT_LE(truth_outside, detected * 10 / 100) << "the truth must lie inside the 99% region";
-  EXPECT_LT(truth_outside, truth_outside_uninflated) << "the inflation must help";
+  // The bar: of the poses reported OK, at most 1% with the truth outside.
+  EXPECT_LE(ok_outside * 100, ok) << "OK poses whose truth lies outside their 99% region";
+  EXPECT_LT(ok_outside + ambiguous_outside, plain_outside) << "the inflation must help";
 }

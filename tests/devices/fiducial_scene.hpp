@@ -2,9 +2,10 @@
 // Shared by the fiducial tests: a small emulated camera and tag poses built from
 // distance and angles.
 #include <cmath>
+#include <random>
 
 #include "covtrack/devices/fiducial/camera_model.hpp"
-#include "covtrack/devices/fiducial/corner_noise.hpp"
+#include "covtrack/devices/fiducial/tag_image_formation.hpp"
 #include "covtrack/protocol/se3.hpp"
 
 namespace covtrack::test {
@@ -15,6 +16,15 @@ inline fiducial::CameraModel small_camera() {
   c.width_px = 320, c.height_px = 240;
   c.fx = c.fy = 277.0;
   c.cx = 159.5, c.cy = 119.5;
+  return c;
+}
+
+// A distortion-free camera of this size whose view spans `horizontal_fov_deg` across.
+inline fiducial::CameraModel camera(int width_px, int height_px, double horizontal_fov_deg) {
+  fiducial::CameraModel c;
+  c.width_px = width_px, c.height_px = height_px;
+  c.fx = c.fy = width_px / 2.0 / std::tan(horizontal_fov_deg * M_PI / 360);
+  c.cx = (width_px - 1) / 2.0, c.cy = (height_px - 1) / 2.0;
   return c;
 }
 
@@ -31,14 +41,24 @@ inline Pose tag_pose(double distance_m, double yaw_deg, double pitch_deg, double
   return T;
 }
 
-// The coefficients fiducial_nees_test calibrates (also the config defaults,
-// devices/fiducial/src/fiducial_config.cpp).
-inline fiducial::CornerNoiseModel calibrated_corner_model() {
-  fiducial::CornerNoiseModel m;
-  m.gain_px = 1.110, m.floor_px = 0.0295, m.aligned_px = 0.0864;
-  m.radial_bias_px = 0.0056, m.radial_sigma_px = 0.0330;
-  m.shift_px = 1.631, m.shift_falloff = 0.16, m.shift_sigma_px = 0.0952;
-  return m;
+// The camera population both sets draw from: tone curves from linear (gamma 1) to sRGB-like
+// (2.4), Gaussian blur with or without a defocus disk, JPEG or none, vignetting, shot and
+// read noise, print contrast (the corner model's calibration population:
+// devices/fiducial/README.md, "Limits").
+inline fiducial::ImageFormation random_formation(std::mt19937_64& rng, fiducial::Rasteriser rasteriser) {
+  std::uniform_real_distribution<double> u(0, 1);
+  const auto in = [&](double lo, double hi) { return lo + (hi - lo) * u(rng); };
+  fiducial::ImageFormation f;
+  f.rasteriser = rasteriser;
+  f.gamma = in(1.0, 2.4);
+  f.gauss_blur_px = in(0.4, 1.25);
+  f.defocus_radius_px = u(rng) < 0.35 ? in(0.8, 1.4) : 0;
+  f.jpeg_quality = u(rng) < 0.5 ? static_cast<int>(in(75, 97)) : 0;
+  f.vignetting = in(0, 0.3);
+  f.read_noise = in(1, 7);
+  f.full_well_e = u(rng) < 0.5 ? in(3000, 8000) : 0;
+  f.paper = in(0.7, 0.9), f.ink = in(0.03, 0.1), f.background = in(0.25, 0.6);
+  return f;
 }
 
 }  // namespace covtrack::test

@@ -26,11 +26,20 @@ std::array<double, 4> CornerNoiseModel::edge_reach(const CornerInputs& in) const
   return reach;
 }
 
+namespace {
+// An unmeasured blur (no slope found) gets no growth term; the floor still applies.
+double blur_or_zero(const CornerInputs& in) {
+  return std::isfinite(in.blur_px) && in.blur_px > 0 ? in.blur_px : 0;
+}
+}  // namespace
+
 EdgeShifts CornerNoiseModel::edge_shift_px(const CornerInputs& in) const {
   const auto reach = edge_reach(in);
+  const double common = in.polarity * scale_bias_per_blur * blur_or_zero(in);
   EdgeShifts shift{};
   for (std::size_t e = 0; e < 4; ++e)
-    for (std::size_t end = 0; end < 2; ++end) shift[e][end] = shift_px * reach[e] * in.inner_white[e][end];
+    for (std::size_t end = 0; end < 2; ++end)
+      shift[e][end] = shift_px * reach[e] * in.inner_white[e][end] + common;
   return shift;
 }
 
@@ -40,8 +49,25 @@ double CornerNoiseModel::sigma_px(const CornerInputs& in) const {
                    aligned_px * aligned_px * in.axis_alignment);
 }
 
+double CornerNoiseModel::scale_sigma(const CornerInputs& in) const {
+  return std::hypot(scale_sigma_px, scale_per_blur * blur_or_zero(in));
+}
+
+double CornerNoiseModel::edge_sigma(const CornerInputs& in) const {
+  return std::hypot(edge_sigma_px, edge_per_blur * blur_or_zero(in));
+}
+
+double CornerNoiseModel::tilt_sigma(const CornerInputs& in) const {
+  return std::hypot(tilt_sigma_px, tilt_per_blur * blur_or_zero(in));
+}
+
 CornerNoise CornerNoiseModel::noise(const CornerInputs& in) const {
-  CornerNoise out{sigma_px(in), radial_bias_px, radial_sigma_px, {}, edge_shift_px(in)};
+  CornerNoise out;
+  out.sigma_px = sigma_px(in);
+  out.scale_sigma_px = scale_sigma(in);
+  out.edge_sigma_px = edge_sigma(in);
+  out.tilt_sigma_px = tilt_sigma(in);
+  out.edge_shift_px = edge_shift_px(in);
   const auto reach = edge_reach(in);
   // Corner k joins edges k - 1 and k.
   for (std::size_t k = 0; k < 4; ++k)
@@ -60,6 +86,7 @@ CornerInputs measure_corner_inputs(const cv::Mat& gray, const Detection& d, cons
   in.blur_px = edge_blur_px(gray, d.corners_px, in.contrast);
   in.border_px = border_width_px(d.corners_px, cells);
   in.inner_white = family.border_inner_white(d.id);
+  in.polarity = family.reversed_border() ? -1 : 1;
   return in;
 }
 
@@ -149,10 +176,13 @@ double edge_blur_px(const cv::Mat& gray, const std::array<cv::Point2d, 4>& c, do
         ++count[static_cast<std::size_t>(i + kHalf)];
       }
   }
+  // Dark inside and light outside, or (reversed-border families) the other way round.
+  const auto mean_at = [&](std::size_t i) { return count[i] ? profile[i] / count[i] : std::nan(""); };
+  const double polarity = mean_at(profile.size() - 1) >= mean_at(0) ? 1.0 : -1.0;
   double slope = 0;
   for (std::size_t i = 1; i + 1 < profile.size(); ++i) {
     if (!count[i - 1] || !count[i + 1]) continue;
-    slope = std::max(slope, (profile[i + 1] / count[i + 1] - profile[i - 1] / count[i - 1]) / (2 * kStep));
+    slope = std::max(slope, polarity * (mean_at(i + 1) - mean_at(i - 1)) / (2 * kStep));
   }
   // A step of height C blurred by a Gaussian of sigma s has a peak slope C / (s sqrt(2 pi)).
   if (slope <= 0) return std::numeric_limits<double>::infinity();

@@ -23,22 +23,33 @@ const TableSpec& fiducial_device_spec() {
         {"quad_sigma", ValueType::Float, "px", "0", "blur before the quad search (0.8 speeds up "
          "noisy frames)", 0, 10},
         {"threads", ValueType::Integer, "", "1", "detector threads", 1, 64},
-        {"corner_gain_px", ValueType::Float, "px", "1.110", "corner noise model: noise/contrast gain "
+        {"corner_gain_px", ValueType::Float, "px", "1.1673", "corner noise model: noise/contrast gain "
          "(devices/fiducial/README.md)", 0, 100},
-        {"corner_floor_px", ValueType::Float, "px", "0.0295", "corner noise model: per-camera floor", 0, 100},
-        {"corner_aligned_px", ValueType::Float, "px", "0.0864", "corner noise model: edges along "
+        {"corner_floor_px", ValueType::Float, "px", "0.0436", "corner noise model: per-camera floor", 0, 100},
+        {"corner_aligned_px", ValueType::Float, "px", "0.0522", "corner noise model: edges along "
          "pixel axes", 0, 100},
-        {"corner_shift_px", ValueType::Float, "px", "1.631", "corner noise model: outward shift of "
+        {"corner_shift_px", ValueType::Float, "px", "1.6552", "corner noise model: outward shift of "
          "an edge lined inside by white cells, at zero border width (corrected)", 0, 100},
-        {"corner_shift_falloff", ValueType::Float, "", "0.16", "corner noise model: that shift "
+        {"corner_shift_falloff", ValueType::Float, "", "0.20", "corner noise model: that shift "
          "fades as exp(-falloff (border / blur)^2)", 0, 100},
-        {"corner_shift_sigma_px", ValueType::Float, "px", "0.0952", "corner noise model: what the "
+        {"corner_shift_sigma_px", ValueType::Float, "px", "1.8573", "corner noise model: what the "
          "shift correction misses, at full reach", 0, 100},
-        {"corner_radial_bias_px", ValueType::Float, "px", "0.0056", "corner noise model: mean "
-         "outward error common to the four corners (removed)", -10, 10},
-        {"corner_radial_sigma_px", ValueType::Float, "px", "0.0330", "corner noise model: spread of "
-         "that common error", 0, 100},
-        {"ambiguity_chi2", ValueType::Float, "", "16", "inflate the covariance to cover the second "
+        {"corner_scale_bias_per_blur", ValueType::Float, "", "-0.2578", "corner noise model: every "
+         "edge's mean outward error per px of edge blur for a dark square (a light one: the "
+         "opposite), from the camera's tone curve (removed)", -10, 10},
+        {"corner_scale_sigma_px", ValueType::Float, "px", "0.0642", "corner noise model: spread of "
+         "the four edges' common outward error (the tag's apparent size), floor", 0, 100},
+        {"corner_scale_per_blur", ValueType::Float, "", "0.1207", "corner noise model: that spread's "
+         "growth per px of edge blur", 0, 100},
+        {"corner_edge_sigma_px", ValueType::Float, "px", "0", "corner noise model: spread of each "
+         "edge's own outward error, floor", 0, 100},
+        {"corner_edge_per_blur", ValueType::Float, "", "0.0282", "corner noise model: that spread's "
+         "growth per px of edge blur", 0, 100},
+        {"corner_tilt_sigma_px", ValueType::Float, "px", "0.0099", "corner noise model: spread of "
+         "each edge's own turn (its ends' opposite outward errors), floor", 0, 100},
+        {"corner_tilt_per_blur", ValueType::Float, "", "0", "corner noise model: that spread's "
+         "growth per px of edge blur", 0, 100},
+        {"ambiguity_chi2", ValueType::Float, "", "40", "inflate the covariance to cover the second "
          "pose when it fits within this many corner variances", 0, 1e6},
         {"rate_hz", ValueType::Float, "Hz", "30", "files: frames per second (0: as fast as "
          "possible); cameras run at their own rate", 0, 10000},
@@ -97,17 +108,23 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
   c.detector.decimate = r.number("decimate", 2);
   c.detector.quad_sigma = r.number("quad_sigma", 0);
   c.detector.threads = static_cast<int>(r.integer("threads", 1));
-  c.noise.gain_px = r.number("corner_gain_px", 1.110);
-  c.noise.floor_px = r.number("corner_floor_px", 0.0295);
-  c.noise.aligned_px = r.number("corner_aligned_px", 0.0864);
-  c.noise.shift_px = r.number("corner_shift_px", 1.631);
-  c.noise.shift_falloff = r.number("corner_shift_falloff", 0.16);
-  c.noise.shift_sigma_px = r.number("corner_shift_sigma_px", 0.0952);
-  c.noise.radial_bias_px = r.number("corner_radial_bias_px", 0.0056);
-  c.noise.radial_sigma_px = r.number("corner_radial_sigma_px", 0.0330);
+  const CornerNoiseModel defaults;
+  c.noise.gain_px = r.number("corner_gain_px", defaults.gain_px);
+  c.noise.floor_px = r.number("corner_floor_px", defaults.floor_px);
+  c.noise.aligned_px = r.number("corner_aligned_px", defaults.aligned_px);
+  c.noise.shift_px = r.number("corner_shift_px", defaults.shift_px);
+  c.noise.shift_falloff = r.number("corner_shift_falloff", defaults.shift_falloff);
+  c.noise.shift_sigma_px = r.number("corner_shift_sigma_px", defaults.shift_sigma_px);
+  c.noise.scale_bias_per_blur = r.number("corner_scale_bias_per_blur", defaults.scale_bias_per_blur);
+  c.noise.scale_sigma_px = r.number("corner_scale_sigma_px", defaults.scale_sigma_px);
+  c.noise.scale_per_blur = r.number("corner_scale_per_blur", defaults.scale_per_blur);
+  c.noise.edge_sigma_px = r.number("corner_edge_sigma_px", defaults.edge_sigma_px);
+  c.noise.edge_per_blur = r.number("corner_edge_per_blur", defaults.edge_per_blur);
+  c.noise.tilt_sigma_px = r.number("corner_tilt_sigma_px", defaults.tilt_sigma_px);
+  c.noise.tilt_per_blur = r.number("corner_tilt_per_blur", defaults.tilt_per_blur);
   if (c.noise.floor_px <= 0 && c.noise.gain_px <= 0)
     r.error("corner_floor_px", "the corner noise model needs a floor or a gain above zero");
-  c.ambiguity_chi2 = r.number("ambiguity_chi2", 16);
+  c.ambiguity_chi2 = r.number("ambiguity_chi2", 40);
   c.rate_hz = r.number("rate_hz", 30);
   c.loop = r.boolean("loop", true);
   c.publish_raw = r.boolean("publish_raw", true);

@@ -64,6 +64,7 @@ TagFamily::~TagFamily() { destroy_(family_); }
 int TagFamily::code_count() const { return static_cast<int>(family_->ncodes); }
 int TagFamily::cells_across_border() const { return family_->width_at_border; }
 int TagFamily::cells_across_total() const { return family_->total_width; }
+bool TagFamily::reversed_border() const { return family_->reversed_border; }
 std::array<std::array<double, 2>, 4> TagFamily::border_inner_white(int id) const {
   std::array<std::array<double, 2>, 4> white{};
   auto m = cells(id);

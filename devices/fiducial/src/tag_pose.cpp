@@ -1,5 +1,7 @@
 #include "covtrack/devices/fiducial/tag_pose.hpp"
 
+#include "covtrack/devices/fiducial/lens_edge_bend.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,6 +12,11 @@
 
 namespace covtrack::fiducial {
 namespace {
+
+// A corner this close to the frame's edge has the white margin beyond its edges cut off,
+// and AprilTag's edge fit then goes astray (measured: a tag whose corner was ~5 px from
+// the top of a 1280x720 frame was tilted 0.1 rad, 30 sigma, by fiducial_coplanar_test).
+constexpr double kImageMarginPx = 8;
 
 // AprilTag 3's corner order, which is also the order SOLVEPNP_IPPE_SQUARE requires.
 std::array<Vec3, 4> tag_corners(double size_m) {
@@ -54,21 +61,57 @@ std::array<cv::Point2d, 4> edge_outward_normals(const std::array<cv::Point2d, 4>
   return normal;
 }
 
+namespace {
+// The step s of a corner with n_a . s = ra and n_b . s = rb (the corner of edges a and b,
+// their lines moved out by ra and rb); zero where the edges are parallel.
+cv::Point2d corner_step(const cv::Point2d& na, const cv::Point2d& nb, double ra, double rb) {
+  const double det = na.cross(nb);
+  if (std::abs(det) < 1e-9) return {0, 0};
+  return {(ra * nb.y - rb * na.y) / det, (rb * na.x - ra * nb.x) / det};
+}
+}  // namespace
+
 std::array<cv::Point2d, 4> move_edges_in(const std::array<cv::Point2d, 4>& c,
                                          const EdgeShifts& shift_px) {
   const auto normal = edge_outward_normals(c);
   std::array<cv::Point2d, 4> out = c;
-  for (int k = 0; k < 4; ++k) {
-    // Corner k lies on edges k - 1 and k: the step s with n_a . s = -shift_a, n_b . s = -shift_b.
-    const auto a = static_cast<std::size_t>((k + 3) % 4), b = static_cast<std::size_t>(k);
-    const double det = normal[a].cross(normal[b]);
-    if (std::abs(det) < 1e-9) continue;
-    // Edge a ends at corner k, edge b starts there.
-    const double ra = -shift_px[a][1], rb = -shift_px[b][0];
-    out[b] += cv::Point2d((ra * normal[b].y - rb * normal[a].y) / det,
-                          (rb * normal[a].x - ra * normal[b].x) / det);
+  for (std::size_t k = 0; k < 4; ++k) {
+    // Corner k lies on edges a = k - 1 (which ends there) and b = k (which starts there).
+    const std::size_t a = (k + 3) % 4, b = k;
+    out[k] += corner_step(normal[a], normal[b], -shift_px[a][1], -shift_px[b][0]);
   }
   return out;
+}
+
+Eigen::Matrix<double, 8, 8> edge_line_modes(const std::array<cv::Point2d, 4>& c) {
+  Eigen::Matrix<double, 8, 8> M;
+  for (std::size_t e = 0; e < 4; ++e)
+    for (const bool turn : {false, true}) {
+      EdgeShifts inward{};  // move_edges_in moves edges in: a negative shift moves one out
+      inward[e] = {-1.0, turn ? 1.0 : -1.0};
+      const auto moved = move_edges_in(c, inward);
+      const auto column = static_cast<Eigen::Index>(e + (turn ? 4 : 0));
+      for (std::size_t k = 0; k < 4; ++k) {
+        const cv::Point2d step = moved[k] - c[k];
+        M(static_cast<Eigen::Index>(2 * k), column) = step.x;
+        M(static_cast<Eigen::Index>(2 * k + 1), column) = step.y;
+      }
+    }
+  return M;
+}
+
+Eigen::Matrix<double, 8, 8> corner_covariance(const std::array<cv::Point2d, 4>& c, const CornerNoise& noise) {
+  const Eigen::Matrix<double, 8, 8> M = edge_line_modes(c);
+  Eigen::Matrix<double, 8, 8> edges = Eigen::Matrix<double, 8, 8>::Zero();
+  edges.topLeftCorner<4, 4>() = noise.edge_sigma_px * noise.edge_sigma_px * Eigen::Matrix4d::Identity() +
+                                noise.scale_sigma_px * noise.scale_sigma_px * Eigen::Matrix4d::Ones();
+  edges.bottomRightCorner<4, 4>() = noise.tilt_sigma_px * noise.tilt_sigma_px * Eigen::Matrix4d::Identity();
+  Eigen::Matrix<double, 8, 8> cov = M * edges * M.transpose();
+  for (int i = 0; i < 8; ++i) {
+    const double extra = noise.extra_px[static_cast<std::size_t>(i / 2)];
+    cov(i, i) += noise.sigma_px * noise.sigma_px + extra * extra;
+  }
+  return cov;
 }
 
 CornerJacobian corner_jacobian(const CameraModel& cam, const Pose& T, double size_m) {
@@ -108,26 +151,21 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
     if (!std::isfinite(p.x) || !std::isfinite(p.y))
       return fail("tag corner is not a finite number");
   if (!(size_m > 0) || !(sigma > 0)) return fail("tag size and corner sigma must be positive");
-  const auto moved = move_edges_in(c, noise.edge_shift_px);
+  if (cam.width_px > 0 && cam.height_px > 0)
+    for (const auto& p : c)
+      if (std::min({p.x, p.y, cam.width_px - 1 - p.x, cam.height_px - 1 - p.y}) < kImageMarginPx)
+        return fail(fmt::format("tag corner ({:.1f}, {:.1f}) within {} px of the image's edge: the white "
+                                "margin the edge fit needs is cut off",
+                                p.x, p.y, kImageMarginPx));
+  auto moved = move_edges_in(c, noise.edge_shift_px);
+  const auto bend = straight_fit_corner_offsets(cam, moved);
+  for (std::size_t k = 0; k < 4; ++k) moved[k] -= bend[k];
   std::vector<cv::Point2d> image(moved.begin(), moved.end());
   if (cam.has_distortion()) cv::undistortPoints(image, image, cam.K(), cam.distortion, cv::noArray(), cam.K());
   const double area = std::abs((image[2] - image[0]).cross(image[3] - image[1])) / 2;
   if (!(area > 4)) return fail(fmt::format("tag quad is degenerate (area {:.2f} px^2)", area));
-  // The common radial error: remove its mean, keep its spread for Sigma_c.
-  const cv::Point2d centre = (image[0] + image[1] + image[2] + image[3]) / 4.0;
-  Eigen::Matrix<double, 8, 1> radial;
-  for (int i = 0; i < 4; ++i) {
-    cv::Point2d r = image[i] - centre;
-    r /= std::max(std::hypot(r.x, r.y), 1e-9);
-    radial(2 * i) = r.x, radial(2 * i + 1) = r.y;
-    image[i] -= noise.radial_bias_px * r;
-  }
-  Eigen::Matrix<double, 8, 8> corner_cov =
-      noise.radial_sigma_px * noise.radial_sigma_px * radial * radial.transpose();
-  for (int i = 0; i < 8; ++i) {
-    const double extra = noise.extra_px[static_cast<std::size_t>(i / 2)];
-    corner_cov(i, i) += sigma * sigma + extra * extra;
-  }
+  const Eigen::Matrix<double, 8, 8> corner_cov =
+      corner_covariance({image[0], image[1], image[2], image[3]}, noise);
 
   const auto object = tag_corners(size_m);
   std::vector<cv::Point3d> obj;
@@ -166,11 +204,19 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
   out.ambiguity_chi2 = std::numeric_limits<double>::infinity();
   if (solutions.size() > 1) {
     out.second = solutions[1];
-    out.ambiguity_chi2 = (solutions[1].sse_px2 - solutions[0].sse_px2) / (sigma * sigma);
+    // How far apart the two poses put the corners, in the corners' own uncertainty
+    // (systematic terms included): what the data can tell apart.
+    Eigen::Matrix<double, 8, 1> d;
+    for (int i = 0; i < 4; ++i) {
+      const cv::Point2d step = cam.project(solutions[1].T_camera_tag * object[i]) -
+                               cam.project(out.best.T_camera_tag * object[i]);
+      d(2 * i) = step.x, d(2 * i + 1) = step.y;
+    }
+    out.ambiguity_chi2 = d.dot(corner_cov.ldlt().solve(d));
     if (out.ambiguity_chi2 < ambiguity_chi2) {
       // The data cannot tell the two apart: cover the step to the other one as well.
-      const Vec6 d = boxminus(solutions[1].T_camera_tag, out.best.T_camera_tag);
-      out.covariance += d * d.transpose();
+      const Vec6 step = boxminus(solutions[1].T_camera_tag, out.best.T_camera_tag);
+      out.covariance += step * step.transpose();
       out.ambiguous = true;
     }
   }

@@ -24,18 +24,24 @@
 // evaluated at each end, so cells near one corner tilt the line). It is a bias of the
 // view (up to 0.45 px at a corner of a rendered small steep tag), constant across noise
 // draws: it is corrected, and what the correction misses enters each corner's variance
-// as shift_sigma_px^2 times the squared reaches of its two edges (a, b). (Entered instead
-// as an error of each edge's whole line, moving both its corners together, this term and
-// the aligned one made validation views up to 3x over-confident.)
+// as shift_sigma_px^2 times the squared reaches of its two edges (a, b).
 //
-// On top of that, all four corners share one error along their radial directions (away
-// from the quad's centre): the detector sees the square a little too small or too large,
-// by radial_bias_px on average (corrected before the pose) with a spread of
-// radial_sigma_px common to the four corners. Independent corner noise would average it
-// away and make the depth over-confident, so it enters Sigma_c as a rank-one term.
-// The floor holds what else noise does not explain (blur, aliasing, the lens).
+// On top of that, the corners share systematic errors that independent corner noise would
+// average away: where a camera's tone curve, point-spread function, sharpening or
+// compression put the edge of a blurred dark-to-light step is not where the step is, by an
+// amount that grows with the blur and whose sign depends on the tag's polarity. Each
+// edge's line is placed off by its own error (edge_sigma, shared by the edge's two
+// corners), turned by its own error (tilt_sigma: its two ends off in opposite senses)
+// and all four edges by a common one (scale_sigma: the square looks too large or
+// too small, which moves the pose along the line of sight). Both grow with the measured
+// blur: sigma = hypot(floor, per_blur * blur). Their mean is not zero: a tone curve that
+// lifts the mid-tones (gamma above 1, as in sRGB) grows the light side into the dark one
+// (0.35-0.45 px per px of blur at gamma 2.2), so a dark square looks smaller and a light one (reversed-border
+// families) larger. scale_bias_per_blur * blur, signed by the polarity, is moved out of
+// every edge before the pose; the spread about it is scale_sigma. A camera's own
+// calibration narrows both. The floor holds what else noise does not explain.
 // A calibration on rendered views with known truth measures the coefficients
-// (fit_corner_noise in noise_calibration.hpp, run by tests/devices/fiducial_nees_test).
+// (fit_corner_noise in noise_calibration.hpp, run by tests/devices/fiducial_heldout_nees_test).
 #include <array>
 
 #include <opencv2/core.hpp>
@@ -56,25 +62,39 @@ struct CornerInputs {
   std::array<double, 4> border_px{};   // per edge: the black border's width (border_width_px)
   std::array<std::array<double, 2>, 4> inner_white{};  // per edge, at its start and end:
                                                        // TagFamily::border_inner_white
+  double polarity = 1;        // +1 dark square on light, -1 light on dark (reversed border)
 };
 
+// The defaults are what fiducial_heldout_nees_test calibrates on its rendered camera
+// population (tone curves gamma 1-2.4, blur 0.4-1.25 px plus defocus, JPEG 75-97 or none;
+// devices/fiducial/README.md); config/schema.md lists the same values.
 struct CornerNoiseModel {
-  double gain_px = 1.0;
-  double floor_px = 0.05;
-  double aligned_px = 0.1;
-  double radial_bias_px = 0;   // mean outward error of every corner (negative: inward)
-  double radial_sigma_px = 0;  // spread of that common radial error
-  double shift_px = 0;         // outward edge shift with all-white cells inside, zero border
-  double shift_falloff = 0.16;  // how fast it fades with border / blur (see above)
-  double shift_sigma_px = 0;   // the shift correction's uncertainty at reach 1
+  double gain_px = 1.1673;
+  double floor_px = 0.0436;
+  double aligned_px = 0.0522;
+  double shift_px = 1.6552;        // outward edge shift with all-white cells inside, zero border
+  double shift_falloff = 0.20;     // how fast it fades with border / blur (see above)
+  double shift_sigma_px = 1.8573;  // the shift correction's uncertainty at reach 1
+  double scale_bias_per_blur = -0.2578;  // every edge's mean outward error per px of blur,
+                                         // for a dark square (a light one: the opposite)
+  double scale_sigma_px = 0.0642;  // the four edges' common outward error: its floor
+  double scale_per_blur = 0.1207;  //   and its growth per px of edge blur
+  double edge_sigma_px = 0.0;      // each edge's own outward error: its floor
+  double edge_per_blur = 0.0282;   //   and its growth per px of edge blur
+  double tilt_sigma_px = 0.0099;   // each edge's own turn (its ends' opposite outward
+  double tilt_per_blur = 0.0;      //   errors, px at each end): floor and growth per px blur
 
   // Per edge: exp(-shift_falloff (border / blur)^2).
   std::array<double, 4> edge_reach(const CornerInputs& in) const;
   // Per edge, at its start and end corner: the predicted outward shift (px),
-  // shift_px * white * reach.
+  // shift_px * white * reach + polarity * scale_bias_per_blur * blur.
   EdgeShifts edge_shift_px(const CornerInputs& in) const;
   // One corner coordinate's standard deviation (px) without the edge shift's term.
   double sigma_px(const CornerInputs& in) const;
+  // The systematic edge errors' standard deviations (px) for this detection's blur.
+  double scale_sigma(const CornerInputs& in) const;
+  double edge_sigma(const CornerInputs& in) const;
+  double tilt_sigma(const CornerInputs& in) const;
   // Everything estimate_tag_pose needs.
   CornerNoise noise(const CornerInputs& in) const;
   // The noise-driven factor the gain multiplies: (noise / contrast)^2 * 16 / max(16, L/8).

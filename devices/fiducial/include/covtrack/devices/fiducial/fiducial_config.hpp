@@ -17,7 +17,7 @@ struct FiducialConfig {
   std::string calibration;     // OpenCV calibration file
   DetectorOptions detector;
   CornerNoiseModel noise;
-  double ambiguity_chi2 = 16;
+  double ambiguity_chi2 = 40;
   double rate_hz = 30;         // files: replay pace (0: as fast as possible); cameras: ignored
   bool loop = true;            // files: start over at the end
   bool publish_raw = true;

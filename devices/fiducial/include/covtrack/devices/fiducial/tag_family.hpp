@@ -29,6 +29,9 @@ class TagFamily {
   // across the whole printed tag (which may extend beyond that square).
   int cells_across_border() const;
   int cells_across_total() const;
+  // True where the detected square is light on a dark ring (tagStandard*, tagCircle*,
+  // tagCustom48h12), false for a dark square on light paper (tag36h11 and the like).
+  bool reversed_border() const;
   // Per edge of the detected square (edge k from corner k to k + 1, AprilTag's corner
   // order), where the data cells lining the inside of the one-cell black border are
   // white: there the border is only one cell thick and the detector's edge refinement is

@@ -4,15 +4,18 @@
 //
 // A square seen in perspective has two poses that fit (the tilt ambiguity); both come
 // from OpenCV's IPPE_SQUARE and are polished by Levenberg-Marquardt. The covariance is
-// (J^T Sigma_c^-1 J)^-1, J the Jacobian of the four projected corners w.r.t. xi, and
-// Sigma_c = diag(sigma^2 + extra_k^2) + radial_sigma^2 r r^T (r: the corners' unit
-// radial directions stacked; extra_k: corner k's edge-shift term; see corner_noise.hpp).
-// Corners are first corrected: each edge's line is moved back in by its predicted
-// outward shift, then every corner by -radial_bias along r. When the second pose fits
-// nearly as well (its extra
-// squared reprojection error below `ambiguity_chi2` corner variances) the covariance
-// gets the outer product of the step to it, so that it covers both. Near face-on, LM can
-// pull both solutions into one minimum; the second is then IPPE's other one, unpolished.
+// (J^T Sigma_c^-1 J)^-1, J the Jacobian of the four projected corners w.r.t. xi, and the
+// full 8x8 corner covariance
+//   Sigma_c = diag(sigma^2 + extra_k^2) + M (edge_sigma^2 I + scale_sigma^2 1 1^T) M^T
+//             + tilt_sigma^2 N N^T,
+// M's column e the corners' displacement when edge e's line moves out by 1 px, N's when
+// it turns so that its start moves out by 1 px and its end in by 1 px (extra_k:
+// corner k's edge-shift term; see corner_noise.hpp). Corners are first corrected: each
+// edge's line is moved back in by its predicted outward shift. The second pose is told apart from the best
+// by the Mahalanobis distance, under Sigma_c, between the corners each predicts; below
+// `ambiguity_chi2` the covariance gets the outer product of the step to it, so that it
+// covers both. Near face-on, LM can pull both solutions into one minimum; the second is
+// then IPPE's other one, unpolished.
 #include <array>
 #include <optional>
 
@@ -37,7 +40,7 @@ struct TagPose {
   std::optional<PoseSolution> second;
   Mat6 covariance = Mat6::Zero();  // BODY convention, inflation included
   double corner_sigma_px = 0;
-  double ambiguity_chi2 = 0;       // (sse second - sse best) / sigma^2; inf without second
+  double ambiguity_chi2 = 0;       // the two poses' corners' Mahalanobis^2; inf without second
   bool ambiguous = false;          // the covariance was inflated to cover the second pose
 };
 
@@ -50,10 +53,11 @@ using EdgeShifts = std::array<std::array<double, 2>, 4>;
 // What the noise model says about one tag's corners.
 struct CornerNoise {
   double sigma_px = 0.1;       // independent, per coordinate
-  double radial_bias_px = 0;   // common outward error, removed before the pose
-  double radial_sigma_px = 0;  // common outward error's spread
+  double scale_sigma_px = 0;   // the four edges' common outward error
+  double edge_sigma_px = 0;    // each edge's own outward error
+  double tilt_sigma_px = 0;    // each edge's own turn: its ends' opposite outward errors
   std::array<double, 4> extra_px{};   // per corner, extra independent error (edge shift)
-  EdgeShifts edge_shift_px{};  // outward shifts of the edges' ends, removed
+  EdgeShifts edge_shift_px{};  // predicted outward shifts of the edges' ends, removed
 };
 
 // Unit outward normals of the quad's edges (edge k runs from corner k to corner k + 1).
@@ -63,6 +67,15 @@ std::array<cv::Point2d, 4> edge_outward_normals(const std::array<cv::Point2d, 4>
 // outward normals by `shift_px` at each end (edge k runs from corner k to corner k + 1).
 std::array<cv::Point2d, 4> move_edges_in(const std::array<cv::Point2d, 4>& corners_px,
                                          const EdgeShifts& shift_px);
+
+// How the four corners (rows u0 v0 u1 v1 ...) move when one edge's line moves and the
+// other three stay: column e (0-3) when edge e moves out along its normal by 1 px, column
+// 4 + e when it turns, its start 1 px out and its end 1 px in.
+Eigen::Matrix<double, 8, 8> edge_line_modes(const std::array<cv::Point2d, 4>& corners_px);
+
+// The full corner covariance of `noise` for a quad with these (corrected) corners.
+Eigen::Matrix<double, 8, 8> corner_covariance(const std::array<cv::Point2d, 4>& corners_px,
+                                              const CornerNoise& noise);
 
 // sigma^2 (J^T J)^-1: the pose covariance from independent corner noise of sigma px.
 Mat6 pose_covariance(const CornerJacobian& J, double corner_sigma_px);
@@ -74,6 +87,6 @@ Mat6 pose_covariance(const CornerJacobian& J, const Eigen::Matrix<double, 8, 8>&
 // a collapsed quad) or when no pose is found.
 Result<TagPose> estimate_tag_pose(const CameraModel& camera,
                                   const std::array<cv::Point2d, 4>& corners_px, double size_m,
-                                  const CornerNoise& noise, double ambiguity_chi2 = 16.0);
+                                  const CornerNoise& noise, double ambiguity_chi2 = 40.0);
 
 }  // namespace covtrack::fiducial
