@@ -182,6 +182,23 @@ TEST(NoTagInView, IsReportedAsRunningWithADetail) {
   EXPECT_TRUE(sink.errors.empty());
 }
 
+// Two prints of tag 2 in one frame, beside tag 9: the copy is reported by id and frame,
+// not dropped in silence, and the first is still posed (with tag 9).
+TEST(DuplicateTagId, IsReportedByIdAndFrame) {
+  const fs::path dir = fresh_dir("duplicate");
+  const RenderedTag copy{2, 0.1, test::tag_pose(0.9, 0, 0, 0, 0.18, -0.1)};
+  const fs::path pattern = write_frames(dir, ".png", {{kTags[0], kTags[1], copy}});
+  EventSink sink;
+  RunningDriver driver(config_for(pattern), sink);
+  const bool done = sink.wait_for([&] { return sink.frames.size() == 1; });
+  auto result = driver.stop();
+  ASSERT_TRUE(result.has_value()) << result.error().message;
+  ASSERT_TRUE(done);
+  ASSERT_EQ(sink.errors.size(), 1u);
+  EXPECT_NE(sink.errors[0].find("tag 2 detected 2 times in frame 0"), std::string::npos) << sink.errors[0];
+  EXPECT_EQ(sink.details, std::vector<std::string>{""}) << "the mapped tags are still posed";
+}
+
 // One still frame looped at 20 Hz: 40 frame periods must span 2 s of the frames' own
 // measurement times. (Starting over used to cost a period: every other period was
 // spent on the wrap, and this source ran at 10 Hz.) A paced driver keeps an absolute

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <map>
 #include <set>
 
 #include <fmt/format.h>
@@ -93,10 +94,14 @@ class FiducialDriver final : public Driver {
   void process(SampleSink& sink, const cv::Mat& gray, std::uint32_t index, std::int64_t time_us) {
     RawFrame raw{index, time_us, estimate_image_noise(gray), {}};
     std::set<int> seen, mapped, unmapped;  // seen: posed
+    std::map<int, int> copies;             // detections per mapped id in this frame
     for (const Detection& det : detector_->detect(gray)) {
       const auto size = config_.tag_size_m.find(det.id);
       (size == config_.tag_size_m.end() ? unmapped : mapped).insert(det.id);
-      if (size == config_.tag_size_m.end() || seen.count(det.id)) continue;
+      if (size == config_.tag_size_m.end()) continue;
+      // One sensor per id: a second print of the same tag (or a false detection) cannot be
+      // told from the first, so only the first is posed and the rest are reported below.
+      if (++copies[det.id] > 1) continue;
       const CornerInputs inputs = measure_corner_inputs(gray, det, detector_->family(), raw.image_noise);
       const CornerNoise noise = config_.noise.noise(inputs);
       auto pose = estimate_tag_pose(camera_, det.corners_px, size->second, noise, config_.ambiguity_chi2);
@@ -117,6 +122,11 @@ class FiducialDriver final : public Driver {
       last_pose_[det.id] = s.T_parent_child;
       sink.pose(s);
     }
+    for (const auto& [id, n] : copies)
+      if (n > 1)
+        sink.count_error(fmt::format("tag {} detected {} times in frame {}: only the first is posed (one "
+                                     "sensor per id; print each tag once, or give the copies other ids)",
+                                     id, n, index));
     // Tags seen before and not now: LOST, so that a client tells "not seen" from "lost message".
     for (const auto& [id, last] : last_pose_) {
       if (seen.count(id)) continue;
