@@ -1,6 +1,8 @@
-// `covtrack render-tags`: AprilTags at known poses through a pinhole camera, with blur
-// and noise, written as an image sequence (or a video) plus a truth file. The fiducial
-// tracker's emulated camera: point its `source` at the output.
+// `covtrack render-tags`: AprilTags at known poses through a camera's image formation
+// (lens distortion from the calibration file, blur and defocus, vignetting, shot and
+// read noise, a tone curve, JPEG: tag_image_formation.hpp), written as an image sequence
+// (or a video) plus a truth file. The fiducial tracker's emulated camera: point its
+// `source` at the output.
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -15,7 +17,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "commands.hpp"
-#include "covtrack/devices/fiducial/tag_renderer.hpp"
+#include "covtrack/devices/fiducial/tag_image_formation.hpp"
 
 namespace covtrack::cli {
 namespace {
@@ -26,6 +28,9 @@ struct RenderArgs {
   int frames = 60;
   double swing_deg = 20, period_frames = 60;
   double noise = 3, blur = 0.8, black = 30, white = 220, background = 128;
+  double gamma = 1, defocus = 0, vignetting = 0, full_well = 0;
+  int jpeg = 0;
+  std::string rasteriser = "supersampled";
   std::uint64_t seed = 1;
 };
 
@@ -65,9 +70,6 @@ std::optional<fiducial::RenderedTag> parse_tag(const std::string& text, std::str
 int run_render(const RenderArgs& a) {
   auto camera = fiducial::load_camera_model(a.camera);
   if (!camera) return fmt::print(stderr, "covtrack render-tags: {}\n", camera.error().message), 2;
-  if (camera->has_distortion())
-    fmt::print(stderr, "covtrack render-tags: note: {} has lens distortion; frames are rendered "
-                       "through its pinhole part only\n", a.camera);
   auto family = fiducial::TagFamily::open(a.family);
   if (!family) return fmt::print(stderr, "covtrack render-tags: {}\n", family.error().message), 2;
   std::vector<fiducial::RenderedTag> tags;
@@ -90,9 +92,16 @@ int run_render(const RenderArgs& a) {
   }
   std::ofstream truth(std::filesystem::path(a.out) / "truth.csv");
   truth << "# frame,id,size_m,x_m,y_m,z_m,qw,qx,qy,qz  (T_camera_tag; camera: OpenCV frame)\n";
-  fiducial::RenderLook look;
-  look.black = a.black, look.white = a.white, look.background = a.background;
-  look.blur_sigma_px = a.blur;
+  // Levels are given in grey levels of a linear camera (gamma 1); the tone curve, if any,
+  // applies on top, as a camera's does.
+  fiducial::ImageFormation formation;
+  formation.rasteriser =
+      a.rasteriser == "analytic" ? fiducial::Rasteriser::AnalyticArea : fiducial::Rasteriser::Supersampled;
+  formation.ink = a.black / 255, formation.paper = a.white / 255, formation.background = a.background / 255;
+  formation.gauss_blur_px = a.blur, formation.defocus_radius_px = a.defocus;
+  formation.read_noise = a.noise, formation.full_well_e = a.full_well;
+  formation.gamma = a.gamma, formation.vignetting = a.vignetting, formation.jpeg_quality = a.jpeg;
+  formation.true_distortion = camera->distortion;  // the lens the calibration describes
   std::mt19937_64 rng(a.seed);
   for (int f = 0; f < a.frames; ++f) {
     // Each tag swings about its own vertical axis, so the frames show motion.
@@ -105,8 +114,7 @@ int run_render(const RenderArgs& a) {
       truth << fmt::format("{},{},{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f}\n", f, t.id,
                            t.size_m, p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z());
     }
-    const cv::Mat image = fiducial::add_sensor_noise(
-        fiducial::render_tags(*camera, **family, now, look), a.noise, rng);
+    const cv::Mat image = fiducial::form_image(*camera, **family, now, formation, rng);
     if (video.isOpened()) video.write(image);
     else cv::imwrite((std::filesystem::path(a.out) / fmt::format("frame_{:04d}.png", f)).string(), image);
   }
@@ -136,6 +144,21 @@ void add_render_tags_command(CLI::App& app) {
   cmd->add_option("--white", args->white, "tag white level")->capture_default_str();
   cmd->add_option("--background", args->background, "background level")->capture_default_str();
   cmd->add_option("--seed", args->seed, "noise seed")->capture_default_str();
+  cmd->add_option("--gamma", args->gamma, "the camera's tone curve: grey = 255 (linear)^(1/gamma); "
+                                          "sRGB-like cameras are near 2.2")
+      ->capture_default_str()->check(CLI::Range(0.2, 5.0));
+  cmd->add_option("--defocus", args->defocus, "defocus disk radius (px), on top of --blur")
+      ->capture_default_str()->check(CLI::Range(0.0, 20.0));
+  cmd->add_option("--vignetting", args->vignetting, "light lost at the frame's corners (0-0.9)")
+      ->capture_default_str()->check(CLI::Range(0.0, 0.9));
+  cmd->add_option("--full-well", args->full_well, "electrons at full scale, for shot noise (0: none)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e7));
+  cmd->add_option("--jpeg", args->jpeg, "JPEG quality the camera compresses with (0: none)")
+      ->capture_default_str()->check(CLI::Range(0, 100));
+  cmd->add_option("--rasteriser", args->rasteriser, "how tags are drawn: supersampled (texture "
+                                                    "warped 4x finer, area-averaged) or analytic "
+                                                    "(exact covered area per pixel)")
+      ->capture_default_str()->check(CLI::IsMember({"supersampled", "analytic"}));
   cmd->callback([args] {
     const int rc = run_render(*args);
     if (rc != 0) throw CLI::RuntimeError(rc);

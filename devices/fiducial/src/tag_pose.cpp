@@ -1,7 +1,5 @@
 #include "covtrack/devices/fiducial/tag_pose.hpp"
 
-#include "covtrack/devices/fiducial/lens_edge_bend.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,6 +8,8 @@
 #include <fmt/format.h>
 #include <opencv2/calib3d.hpp>
 
+#include "covtrack/devices/fiducial/lens_edge_bend.hpp"
+
 namespace covtrack::fiducial {
 namespace {
 
@@ -17,6 +17,14 @@ namespace {
 // and AprilTag's edge fit then goes astray (measured: a tag whose corner was ~5 px from
 // the top of a 1280x720 frame was tilted 0.1 rad, 30 sigma, by fiducial_coplanar_test).
 constexpr double kImageMarginPx = 8;
+
+// The step s of a corner with n_a . s = ra and n_b . s = rb (the corner of edges a and b,
+// their lines moved out by ra and rb); zero where the edges are parallel.
+cv::Point2d corner_step(const cv::Point2d& na, const cv::Point2d& nb, double ra, double rb) {
+  const double det = na.cross(nb);
+  if (std::abs(det) < 1e-9) return {0, 0};
+  return {(ra * nb.y - rb * na.y) / det, (rb * na.x - ra * nb.x) / det};
+}
 
 // AprilTag 3's corner order, which is also the order SOLVEPNP_IPPE_SQUARE requires.
 std::array<Vec3, 4> tag_corners(double size_m) {
@@ -60,16 +68,6 @@ std::array<cv::Point2d, 4> edge_outward_normals(const std::array<cv::Point2d, 4>
   }
   return normal;
 }
-
-namespace {
-// The step s of a corner with n_a . s = ra and n_b . s = rb (the corner of edges a and b,
-// their lines moved out by ra and rb); zero where the edges are parallel.
-cv::Point2d corner_step(const cv::Point2d& na, const cv::Point2d& nb, double ra, double rb) {
-  const double det = na.cross(nb);
-  if (std::abs(det) < 1e-9) return {0, 0};
-  return {(ra * nb.y - rb * na.y) / det, (rb * na.x - ra * nb.x) / det};
-}
-}  // namespace
 
 std::array<cv::Point2d, 4> move_edges_in(const std::array<cv::Point2d, 4>& c,
                                          const EdgeShifts& shift_px) {
