@@ -125,6 +125,17 @@ FiducialConfig config_for(const fs::path& pattern) {
   return c;
 }
 
+// Runs the driver on the files of `pattern` until `done` holds (under the sink's lock);
+// returns whether it did. The driver must stop cleanly.
+template <typename Done>
+bool run_until(EventSink& sink, const fs::path& pattern, Done done) {
+  RunningDriver driver(config_for(pattern), sink);
+  const bool reached = sink.wait_for(done);
+  auto result = driver.stop();
+  EXPECT_TRUE(result.has_value()) << result.error().message;
+  return reached;
+}
+
 void cut_to_half(const fs::path& file) {
   fs::resize_file(file, fs::file_size(file) / 2);
 }
@@ -142,12 +153,9 @@ TEST_P(DamagedFrame, IsNamedAndSkippedAndTheFramesAroundItAreProcessed) {
   const fs::path pattern = write_frames(dir, ext, std::vector<std::vector<RenderedTag>>(5, kTags));
   cut_to_half(dir / ("frame_0002" + ext));
   EventSink sink;
-  RunningDriver driver(config_for(pattern), sink);
   // The frame index counts every frame read, so index 4 is the last file's.
-  const bool last_done = sink.wait_for([&] { return !sink.frames.empty() && sink.frames.back().frame == 4; });
-  auto result = driver.stop();
-  ASSERT_TRUE(result.has_value()) << result.error().message;
-  ASSERT_TRUE(last_done) << "the last frame was never processed";
+  ASSERT_TRUE(run_until(sink, pattern, [&] { return !sink.frames.empty() && sink.frames.back().frame == 4; }))
+      << "the last frame was never processed";
   std::vector<std::uint32_t> processed;
   for (const RawFrame& f : sink.frames) {
     processed.push_back(f.frame);
@@ -171,11 +179,7 @@ TEST(NoTagInView, IsReportedAsRunningWithADetail) {
   const RenderedTag unmapped{5, 0.1, test::tag_pose(0.9, 10, 0, 0)};
   const fs::path pattern = write_frames(dir, ".png", {{}, {}, {unmapped}, kTags});
   EventSink sink;
-  RunningDriver driver(config_for(pattern), sink);
-  const bool done = sink.wait_for([&] { return sink.frames.size() == 4; });
-  auto result = driver.stop();
-  ASSERT_TRUE(result.has_value()) << result.error().message;
-  ASSERT_TRUE(done);
+  ASSERT_TRUE(run_until(sink, pattern, [&] { return sink.frames.size() == 4; }));
   const std::vector<std::string> expected = {"no tag in view",
                                              "no mapped tag in view (seen, not in the tag map: 5)", ""};
   EXPECT_EQ(sink.details, expected);
@@ -189,11 +193,7 @@ TEST(DuplicateTagId, IsReportedByIdAndFrame) {
   const RenderedTag copy{2, 0.1, test::tag_pose(0.9, 0, 0, 0, 0.18, -0.1)};
   const fs::path pattern = write_frames(dir, ".png", {{kTags[0], kTags[1], copy}});
   EventSink sink;
-  RunningDriver driver(config_for(pattern), sink);
-  const bool done = sink.wait_for([&] { return sink.frames.size() == 1; });
-  auto result = driver.stop();
-  ASSERT_TRUE(result.has_value()) << result.error().message;
-  ASSERT_TRUE(done);
+  ASSERT_TRUE(run_until(sink, pattern, [&] { return sink.frames.size() == 1; }));
   ASSERT_EQ(sink.errors.size(), 1u);
   EXPECT_NE(sink.errors[0].find("tag 2 detected 2 times in frame 0"), std::string::npos) << sink.errors[0];
   EXPECT_EQ(sink.details, std::vector<std::string>{""}) << "the mapped tags are still posed";

@@ -106,8 +106,11 @@ std::vector<ViewDraw> draws_of(const TagRun& r, std::uint64_t seed) {
 }
 
 // One line per view: how it was made, how far its corners were off, its mean pose NEES.
-void print_views(const std::vector<TagRun>& runs, const std::vector<std::vector<ViewDraw>>& draws,
-                 const CornerNoiseModel& model) {
+// Returns each view's mean pose NEES and how many draws it is over.
+std::vector<std::pair<double, int>> print_views(const std::vector<TagRun>& runs,
+                                                const std::vector<std::vector<ViewDraw>>& draws,
+                                                const CornerNoiseModel& model) {
+  std::vector<std::pair<double, int>> nees;
   std::printf("%4s %-17s %9s %5s %5s %4s %4s %6s %7s %7s %7s\n", "view", "family", "camera", "gamma",
               "blur", "defo", "jpeg", "edge", "rmsCorn", "common", "NEES");
   for (std::size_t i = 0; i < runs.size(); ++i) {
@@ -121,11 +124,14 @@ void print_views(const std::vector<TagRun>& runs, const std::vector<std::vector<
       for (double out : e.edge_out_px) common += out / 4;
       edge += d.inputs.edge_length_px, ++n;
     }
+    auto& [mean_nees, posed] = nees.emplace_back();
+    mean_nees = mean_pose_nees(runs[i].view, draws[i], model, &posed);
     std::printf("%4zu %-17s %4dx%-4d %5.1f %5.2f %4.1f %4d %6.1f %7.3f %7.3f %7.2f\n", i,
                 runs[i].family.c_str(), runs[i].view.camera.width_px, runs[i].view.camera.height_px,
                 f.gamma, f.gauss_blur_px, f.defocus_radius_px, f.jpeg_quality, n ? edge / n : 0,
-                n ? std::sqrt(sq / n) : 0, n ? common / n : 0, mean_pose_nees(runs[i].view, draws[i], model));
+                n ? std::sqrt(sq / n) : 0, n ? common / n : 0, mean_nees);
   }
+  return nees;
 }
 
 }  // namespace
@@ -173,12 +179,10 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
   int pooled_n = 0;
   std::vector<std::vector<ViewDraw>> validation_draws;
   for (std::size_t i = 0; i < validation.size(); ++i) validation_draws.push_back(draws_of(validation[i], 5000 + i));
-  print_views(validation, validation_draws, model);
+  const auto view_nees = print_views(validation, validation_draws, model);
   for (std::size_t i = 0; i < validation.size(); ++i) {
     const TagRun& r = validation[i];
-    const auto& d = validation_draws[i];
-    int n = 0;
-    const double mean = mean_pose_nees(r.view, d, model, &n);
+    const auto [mean, n] = view_nees[i];
     by_condition[r.condition].first += mean * n;
     by_condition[r.condition].second += n;
     pooled_sum += mean * n, pooled_n += n;

@@ -23,8 +23,8 @@ namespace {
 // What the device status says beside RUNNING: nothing while a tag of the map is in
 // view; otherwise that the camera works but sees none, and which other tags it sees (a
 // wrong family or tag map shows here).
-std::string view_detail(const std::set<int>& mapped, const std::set<int>& unmapped) {
-  if (!mapped.empty()) return {};
+std::string view_detail(bool mapped_in_view, const std::set<int>& unmapped) {
+  if (mapped_in_view) return {};
   if (unmapped.empty()) return "no tag in view";
   return fmt::format("no mapped tag in view (seen, not in the tag map: {})", fmt::join(unmapped, ", "));
 }
@@ -93,12 +93,14 @@ class FiducialDriver final : public Driver {
 
   void process(SampleSink& sink, const cv::Mat& gray, std::uint32_t index, std::int64_t time_us) {
     RawFrame raw{index, time_us, estimate_image_noise(gray), {}};
-    std::set<int> seen, mapped, unmapped;  // seen: posed
-    std::map<int, int> copies;             // detections per mapped id in this frame
+    std::set<int> seen, unmapped;  // seen: posed
+    std::map<int, int> copies;     // detections per mapped id in this frame
     for (const Detection& det : detector_->detect(gray)) {
       const auto size = config_.tag_size_m.find(det.id);
-      (size == config_.tag_size_m.end() ? unmapped : mapped).insert(det.id);
-      if (size == config_.tag_size_m.end()) continue;
+      if (size == config_.tag_size_m.end()) {
+        unmapped.insert(det.id);
+        continue;
+      }
       // One sensor per id: a second print of the same tag (or a false detection) cannot be
       // told from the first, so only the first is posed and the rest are reported below.
       if (++copies[det.id] > 1) continue;
@@ -137,7 +139,7 @@ class FiducialDriver final : public Driver {
       s.status = TrackingStatus::Lost;
       sink.pose(s);
     }
-    sink.running(view_detail(mapped, unmapped));
+    sink.running(view_detail(!copies.empty(), unmapped));
     if (config_.publish_raw) {
       const auto bytes = encode_raw_frame(raw);
       sink.raw(ByteDirection::FromDevice, bytes.data(), bytes.size());

@@ -124,32 +124,43 @@ struct CornerSample {
   double sq_px2;
 };
 
+// A detected draw and its corner errors after the predicted shifts (stage 1's), which
+// stages 2 and 3 both read: computed once.
+struct DrawErrors {
+  const ViewDraw* draw;
+  CornerErrors errors;
+};
+using ErrorsByView = std::vector<std::vector<DrawErrors>>;
+
+ErrorsByView errors_by_view(const CornerNoiseModel& model, const std::vector<std::vector<ViewDraw>>& views) {
+  ErrorsByView out;
+  for (const auto& draws : views) {
+    auto& view = out.emplace_back();
+    for (const ViewDraw& d : draws)
+      if (d.detection) view.push_back({&d, corner_errors(model, d)});
+  }
+  return out;
+}
+
 // Each corner's error about its view's mean error for that corner: the draw-to-draw
 // spread, which the independent terms model (the view's mean is the systematic terms').
-std::vector<std::vector<CornerSample>> corner_samples(const CornerNoiseModel& model,
-                                                      const std::vector<std::vector<ViewDraw>>& views) {
+std::vector<std::vector<CornerSample>> corner_samples(const CornerNoiseModel& model, const ErrorsByView& views) {
   std::vector<std::vector<CornerSample>> out;
-  for (const auto& draws : views) {
+  for (const auto& view : views) {
     auto& samples = out.emplace_back();
-    std::vector<const ViewDraw*> detected;
-    std::vector<CornerErrors> errors;
-    std::array<cv::Point2d, 4> mean{};
-    for (const ViewDraw& d : draws)
-      if (d.detection) {
-        detected.push_back(&d), errors.push_back(corner_errors(model, d));
-        for (std::size_t k = 0; k < 4; ++k) mean[k] += errors.back().error_px[k];
-      }
-    const double n = static_cast<double>(detected.size());
+    const double n = static_cast<double>(view.size());
     if (n < 3) continue;
-    for (auto& m : mean) m /= n;
-    for (std::size_t i = 0; i < detected.size(); ++i) {
-      const CornerInputs& in = detected[i]->inputs;
+    std::array<cv::Point2d, 4> mean{};
+    for (const DrawErrors& de : view)
+      for (std::size_t k = 0; k < 4; ++k) mean[k] += de.errors.error_px[k] / n;
+    for (const DrawErrors& de : view) {
+      const CornerInputs& in = de.draw->inputs;
       const auto reach = model.edge_reach(in);
       const double noise = CornerNoiseModel::noise_term(in.image_noise, in.contrast, in.edge_length_px);
       for (std::size_t k = 0; k < 4; ++k) {
         const std::size_t a = (k + 3) % 4;  // corner k joins edges k - 1 and k
         const double r = reach[a] * reach[a] + reach[k] * reach[k];
-        const cv::Point2d e = errors[i].error_px[k] - mean[k];
+        const cv::Point2d e = de.errors.error_px[k] - mean[k];
         samples.push_back({Vec4(1, noise, in.axis_alignment, r), e.dot(e) * n / (n - 1)});
       }
     }
@@ -289,14 +300,13 @@ std::pair<double, double> fit_floor_and_growth(const std::vector<std::pair<doubl
 // part took one quarter of each edge's own); each edge's mean turn (half its start's
 // minus its end's error) has tilt_sigma^2. The means' sampling variance, from the
 // draw-to-draw spread, is taken off.
-void fit_systematic_terms(CornerNoiseModel& m, const std::vector<std::vector<ViewDraw>>& views) {
+void fit_systematic_terms(CornerNoiseModel& m, const ErrorsByView& views) {
   std::vector<std::pair<double, double>> scale_points, edge_points, tilt_points;
-  for (const auto& draws : views) {
+  for (const auto& view : views) {
     std::vector<CornerErrors> errors;
     double blur = 0;
-    for (const ViewDraw& d : draws)
-      if (d.detection && std::isfinite(d.inputs.blur_px))
-        errors.push_back(corner_errors(m, d)), blur += d.inputs.blur_px;
+    for (const DrawErrors& de : view)
+      if (std::isfinite(de.draw->inputs.blur_px)) errors.push_back(de.errors), blur += de.draw->inputs.blur_px;
     const double n = static_cast<double>(errors.size());
     if (n < 3) continue;
     blur /= n;
@@ -331,12 +341,13 @@ CornerNoiseModel fit_corner_noise(const std::vector<CalibrationView>& views,
                                   const std::vector<std::vector<ViewDraw>>& draws) {
   CornerNoiseModel m;
   fit_edge_shift(m, draws);
-  const auto samples = corner_samples(m, draws);
+  const ErrorsByView errors = errors_by_view(m, draws);
+  const auto samples = corner_samples(m, errors);
   Vec4 c = initial_terms(samples);
   log_search(c, [&](const Vec4& t) { return log_ratio_cost(samples, t); }, 1e-8);
   m.floor_px = std::sqrt(c[0]), m.gain_px = std::sqrt(c[1]), m.aligned_px = std::sqrt(c[2]);
   m.shift_sigma_px = std::sqrt(c[3]);
-  fit_systematic_terms(m, draws);
+  fit_systematic_terms(m, errors);
   // Stage 4 on the pooled NEES: with the systematic terms in the model a view's own mean
   // NEES is expected to scatter (its biases are one draw of them), so only the pool says
   // whether the spreads are right.
