@@ -1,5 +1,5 @@
 // The XpressNet decoder on byte vectors: framing, XOR, LI-USB prefixes, resync on
-// garbage, and every message of reference/protocols.md part A (values from there).
+// garbage, and every message of docs/xpressnet.md (values from there).
 #include <gtest/gtest.h>
 
 #include <variant>

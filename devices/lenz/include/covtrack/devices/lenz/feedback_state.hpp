@@ -1,7 +1,7 @@
 #pragma once
 // The inputs of the RS-bus feedback modules as last reported: each broadcast carries one
 // nibble (inputs 1-4 or 5-8) of one module, so an input is known only once its nibble
-// has been reported (reference/protocols.md, A.5-A.6).
+// has been reported (docs/xpressnet.md, "Feedback" and "Sensor numbers").
 #include <array>
 #include <cstdint>
 #include <optional>

@@ -4,7 +4,7 @@
 //
 // A frame is HDR D1..Dn XOR: the header's low nibble is n, XOR is the XOR of every
 // earlier byte. The LI-USB puts FF FE before replies and FF FD before unsolicited
-// broadcasts; the LI101F sends no prefix. (reference/protocols.md, A.1 and A.3)
+// broadcasts; the LI101F sends no prefix. (docs/xpressnet.md, "Framing" and "USB interfaces")
 #include <cstddef>
 #include <cstdint>
 #include <span>

@@ -1,7 +1,7 @@
 #pragma once
 // The meaning of XpressNet frames: what the interface and command station send to the
 // PC (replies and broadcasts), what the PC sends (requests), and builders for both.
-// Pure functions over frames (reference/protocols.md, A.1, A.4, A.5).
+// Pure functions over frames (docs/xpressnet.md).
 #include <cstdint>
 #include <string>
 #include <variant>

@@ -5,7 +5,7 @@
 // Why not call libserial's Read/Close directly: on a device that went away (USB-serial
 // adapter unplugged, emulator closed its pseudo-terminal) Read throws with the text
 // "Success", and Close throws from the destructor, which terminates the process
-// (reference/pitfalls.md). Reading and writing here go through the raw descriptor with
+// (docs/libserial.md). Reading and writing here go through the raw descriptor with
 // poll(), and the teardown is made safe before libserial gets to restore settings. The
 // same destructor abort follows opening a path that is not a terminal (a typo naming a
 // file), so open() checks the path's kind first.
