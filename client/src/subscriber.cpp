@@ -8,9 +8,8 @@
 #include <regex>
 #include <thread>
 
-#include <covtrack/pose_cov_t.hpp>
-
 #include "covtrack/client/pose_validation.hpp"
+#include "covtrack/protocol/channel_messages.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 
@@ -52,7 +51,7 @@ struct Subscriber::Impl {
   int wake_fd = -1;
   std::jthread thread;
 
-  mutable std::mutex mutex;  // guards streams and statuses
+  mutable std::mutex mutex;  // guards streams, statuses and rejections
   struct Stream {
     StreamState state;
     std::int64_t last_sequence = -1;  // of the last decoded message, accepted or not
@@ -64,6 +63,7 @@ struct Subscriber::Impl {
   };
   std::map<std::string, Stream> streams;  // by "device/sensor"
   std::map<std::string, device_status_t> statuses;
+  RejectionTally rejections;  // every rejected message, of any channel
 
   std::mutex callbacks_mutex;
   std::shared_ptr<const CallbackList> callbacks = std::make_shared<CallbackList>();
@@ -77,21 +77,22 @@ struct Subscriber::Impl {
     return callbacks;
   }
 
+  // Counts a message that no stream can own: its channel is not a stream's, or a heartbeat.
+  void reject_unowned(const std::string& channel, const WireRejection& why) {
+    std::lock_guard lock(mutex);
+    rejections.add(to_string(why.fault), channel, why.describe());
+  }
+
   void on_pose_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     const std::int64_t now = now_us();
+    const auto decoded = decode_pose(channel, bytes_of(rbuf->data, rbuf->data_size));
     const auto id = parse_pose_channel(channel);
-    if (!id) return;  // matched the regex but is not a well-formed stream name
-    pose_cov_t msg;
-    const bool decoded = msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) >= 0;
-    // Only a message that names this stream tells anything about its sequence numbers.
-    const bool ours = decoded && msg.device == id->device && msg.sensor == id->sensor;
-    std::optional<std::string> reason;
+    if (!id) return reject_unowned(channel, decoded.error());
+    std::optional<std::pair<std::string, std::string>> rejection;  // reason, description
     if (!decoded)
-      reason = "malformed message (" + std::to_string(rbuf->data_size) + " bytes)";
-    else if (!ours)
-      reason = "device/sensor '" + msg.device + "/" + msg.sensor + "' differ from the channel";
-    else
-      reason = rejection_reason(msg);
+      rejection.emplace(to_string(decoded.error().fault), decoded.error().describe());
+    else if (auto invalid = rejection_reason(*decoded))
+      rejection.emplace("invalid pose", *invalid);
 
     const auto current_callbacks = callback_snapshot();
     std::optional<TrackedTransform> accepted;
@@ -100,20 +101,22 @@ struct Subscriber::Impl {
       std::lock_guard lock(mutex);
       Stream& s = streams[id->key()];
       s.state.id = *id;
-      // A rejected message still arrived: its sequence number is no loss.
-      if (ours) {
-        s.state.counters.lost += skipped_before(s.last_sequence, msg.sequence);
-        s.last_sequence = msg.sequence;
+      // A decoded message names this stream (decode_pose checks it), so its sequence
+      // number counts even if its values are rejected: it arrived, it is no loss.
+      if (decoded) {
+        s.state.counters.lost += skipped_before(s.last_sequence, decoded->sequence);
+        s.last_sequence = decoded->sequence;
       }
-      if (reason) {
+      if (rejection) {
         ++s.state.counters.rejected;
-        s.state.last_rejection = *reason;
+        s.state.last_rejection = rejection->second;
+        rejections.add(rejection->first, channel, rejection->second);
         return;
       }
       s.last_accept_us = now;
       s.state.stale = false;
       ++s.state.counters.received;
-      s.state.latest = to_tracked_transform(msg, now);
+      s.state.latest = to_tracked_transform(*decoded, now);
       accepted = s.state.latest;
       if (s.matched_for != current_callbacks) {
         s.matched.clear();
@@ -128,9 +131,11 @@ struct Subscriber::Impl {
     for (const PoseCallback* cb : to_call) (*cb)(*accepted);
   }
 
-  void on_status(const lcm::ReceiveBuffer*, const std::string&, const device_status_t* msg) {
+  void on_status_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    auto decoded = decode_status(channel, bytes_of(rbuf->data, rbuf->data_size));
+    if (!decoded) return reject_unowned(channel, decoded.error());
     std::lock_guard lock(mutex);
-    statuses[msg->device] = *msg;
+    statuses[decoded->device] = std::move(*decoded);
   }
 
   void mark_stale() {
@@ -186,7 +191,7 @@ Result<std::unique_ptr<Subscriber>> Subscriber::attach(std::shared_ptr<lcm::LCM>
   auto* poses = raw->lcm->subscribe(std::string(kPosePrefix) + "(" + options.pattern + ")",
                                     &Impl::on_pose_bytes, raw);
   poses->setQueueCapacity(options.queue_capacity);
-  auto* status = raw->lcm->subscribe(std::string(kStatusPrefix) + ".*", &Impl::on_status, raw);
+  auto* status = raw->lcm->subscribe(std::string(kStatusPrefix) + ".*", &Impl::on_status_bytes, raw);
   status->setQueueCapacity(kStatusQueueCapacity);
   raw->subscriptions = {poses, status};
   raw->thread = std::jthread([raw](std::stop_token stop) { raw->dispatch(stop); });
@@ -228,6 +233,11 @@ std::vector<StreamState> Subscriber::streams() const {
 std::map<std::string, device_status_t> Subscriber::device_statuses() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->statuses;
+}
+
+RejectionTally Subscriber::rejections() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->rejections;
 }
 
 void Subscriber::stop() {

@@ -176,7 +176,7 @@ TEST_F(SubscriberTest, InvalidMessagesAreRejectedCountedAndNeverDelivered) {
   EXPECT_EQ(calls, 0);
   EXPECT_EQ(received("dev", "s"), 0);
   EXPECT_FALSE(sub_->latest({"dev", "s"}));
-  EXPECT_NE(sub_->stream({"dev", "s"})->last_rejection.find("malformed"), std::string::npos);
+  EXPECT_NE(sub_->stream({"dev", "s"})->last_rejection.find("truncated"), std::string::npos);
 
   // A valid message is delivered; a later invalid one does not replace it.
   publish(pose_message("dev", "s", 5));
@@ -184,6 +184,36 @@ TEST_F(SubscriberTest, InvalidMessagesAreRejectedCountedAndNeverDelivered) {
   ASSERT_TRUE(eventually([&] { return counters("dev", "s").rejected == 7; }));
   EXPECT_EQ(calls, 1);
   EXPECT_EQ(sub_->latest({"dev", "s"})->sequence, 5);
+}
+
+TEST_F(SubscriberTest, MalformedMessagesAreCountedByReasonAndGoodOnesStillArrive) {
+  // The messages that ended clients: a string length of 0 or less made LCM's decoder throw.
+  std::vector<std::uint8_t> good(static_cast<std::size_t>(pose_message("dev", "s", 0).getEncodedSize()));
+  pose_message("dev", "s", 0).encode(good.data(), 0, static_cast<int>(good.size()));
+  const std::size_t device_length_at = 8 + 24;  // fingerprint, three int64
+  for (std::uint8_t last : {0x00, 0xff}) {  // length 0, then -1
+    auto bad = good;
+    for (int i = 0; i < 4; ++i) bad[device_length_at + i] = i < 3 ? (last ? 0xff : 0x00) : last;
+    lcm_->publish(pose_channel("dev", "s"), bad.data(), static_cast<unsigned>(bad.size()));
+  }
+  auto wrong_type = good;
+  wrong_type[0] ^= 0x01;
+  lcm_->publish(pose_channel("dev", "s"), wrong_type.data(), static_cast<unsigned>(wrong_type.size()));
+  const std::uint8_t garbage[] = {1, 2, 3};
+  lcm_->publish("covtrack/pose/not a stream", garbage, sizeof garbage);  // counted, yet no stream's
+  lcm_->publish(status_channel("dev"), garbage, sizeof garbage);          // a heartbeat's turn
+  publish(pose_message("dev", "s", 1));
+  ASSERT_TRUE(eventually([&] { return received("dev", "s") == 1 && sub_->rejections().total == 5; }));
+  const RejectionTally tally = sub_->rejections();
+  EXPECT_EQ(tally.by_reason.at("bad length"), 2);
+  EXPECT_EQ(tally.by_reason.at("wrong type"), 1);
+  EXPECT_EQ(tally.by_reason.at("bad channel"), 1);
+  EXPECT_EQ(tally.by_reason.at("truncated"), 1);
+  EXPECT_NE(tally.last.find("covtrack/status/dev"), std::string::npos) << tally.last;
+  EXPECT_EQ(counters("dev", "s").rejected, 3);
+  EXPECT_EQ(counters("dev", "s").lost, 0);  // the malformed ones told nothing of the sequence
+  EXPECT_EQ(sub_->streams().size(), 1u);
+  EXPECT_TRUE(sub_->device_statuses().empty());
 }
 
 TEST_F(SubscriberTest, EachDefectIsNamedInTheRejection) {

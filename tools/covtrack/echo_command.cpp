@@ -18,6 +18,7 @@
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "stop_signal.hpp"
+#include "subscriber_summary.hpp"
 
 namespace covtrack::cli {
 namespace {
@@ -107,6 +108,8 @@ std::string table(const client::Subscriber& sub, RateMeter& rates) {
   }
   out += "σ: 1-sigma along the worst direction (sqrt of the largest eigenvalue of the 3x3 "
          "position / rotation block, BODY frame); stale times: how often it went stale\n";
+  if (const RejectionTally rejected = sub.rejections(); rejected.total > 0)
+    out += "rejected messages: " + rejected.summary() + "\n";
   for (const auto& [device, st] : sub.device_statuses())
     out += fmt::format("device {:<20} {:>7.1f} Hz reports {:>9} errors {:>4} drops {:>4} restarts {:>3}{}{}\n",
                        device, st.rate_hz, st.reports, st.errors, st.drops, st.restarts,
@@ -150,6 +153,7 @@ int run_echo(const EchoOptions& o) {
     }
   }
   (*sub)->stop();
+  std::cerr << subscriber_summary(**sub, "covtrack echo: ");
   return 0;
 }
 

@@ -27,6 +27,7 @@
 #include "region_drawing.hpp"
 #include "regions_report.hpp"
 #include "stop_signal.hpp"
+#include "subscriber_summary.hpp"
 #include "view_background.hpp"
 #include "view_log.hpp"
 #include "view_widgets.hpp"
@@ -128,6 +129,16 @@ int run_view(const ViewArgs& args) {
     latest_report = [&log](const StreamId& id) { return log->latest(id); };
   }
 
+  // What the streams brought, and what was refused, when the view ends.
+  const auto report_rejections = [&] {
+    if (subscriber) {
+      subscriber->stop();
+      std::cerr << subscriber_summary(*subscriber, "covtrack view: ");
+    }
+    if (log && log->rejections().total > 0)
+      std::cerr << "covtrack view: rejected pose messages of the log: " << log->rejections().summary() << "\n";
+  };
+
   const cv::Size size(model->camera.width_px, model->camera.height_px);
   std::string warning;
   ViewBackground background(args.background, size, warning);
@@ -186,6 +197,7 @@ int run_view(const ViewArgs& args) {
 
     if (!args.png_path.empty()) {
       if (auto r = write_png(image, args.png_path); !r) return fail_with(r.error().message, 1);
+      report_rejections();
       return 0;
     }
     if (video) video->write(image);
@@ -196,6 +208,7 @@ int run_view(const ViewArgs& args) {
     }
     if (last) break;
   }
+  report_rejections();
   return 0;
 }
 

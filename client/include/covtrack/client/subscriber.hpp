@@ -13,10 +13,13 @@
 // nor destroy the Subscriber.
 //
 // What is delivered: a message is rejected (counted, never passed to latest() or a
-// callback) when it cannot be decoded, names another device/sensor than its channel,
-// has an unknown status or convention, a non-finite position, a non-unit quaternion or
-// a covariance that is non-finite, asymmetric or not positive semi-definite. LOST
-// messages skip the covariance checks: see TrackedTransform.
+// callback) when it fails the wire checks (decode_pose(): type, lengths, names; a
+// malformed message cannot end the process), names another device/sensor than its
+// channel, has an unknown status or convention, a non-finite position, a non-unit
+// quaternion or a covariance that is non-finite, asymmetric or not positive
+// semi-definite. LOST messages skip the covariance checks: see TrackedTransform.
+// Heartbeats are checked the same way (decode_status()). Every rejection is counted by
+// its reason in rejections(); those of a stream's channel also in its counters.
 #include <functional>
 #include <map>
 #include <memory>
@@ -28,6 +31,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "covtrack/client/tracked_transform.hpp"
+#include "covtrack/protocol/rejection_tally.hpp"
 #include "covtrack/protocol/result.hpp"
 
 namespace covtrack::client {
@@ -84,6 +88,8 @@ class Subscriber {
   std::vector<StreamState> streams() const;  // ordered by device/sensor
   // The last heartbeat (covtrack/status/<device>) of each device, by device name.
   std::map<std::string, device_status_t> device_statuses() const;
+  // Every message rejected so far (poses, heartbeats, channels that name no stream).
+  RejectionTally rejections() const;
 
   // Ends the dispatch thread; idempotent, prompt even when no message arrives. After it
   // no callback runs; latest() and the counters keep their last values.

@@ -1,0 +1,15 @@
+#include "covtrack/protocol/rejection_tally.hpp"
+
+#include <fmt/format.h>
+
+namespace covtrack {
+
+std::string RejectionTally::summary() const {
+  if (total == 0) return "0";
+  std::string reasons;
+  for (const auto& [reason, count] : by_reason)
+    reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", reason, count);
+  return fmt::format("{} ({}); last: {}", total, reasons, last);
+}
+
+}  // namespace covtrack

@@ -1,0 +1,143 @@
+#include "covtrack/protocol/wire_decode.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cstdint>
+#include <exception>
+
+#include <fmt/format.h>
+
+#include "wire_layout.hpp"
+
+namespace covtrack {
+
+const char* to_string(WireFault fault) {
+  switch (fault) {
+    case WireFault::Truncated: return "truncated";
+    case WireFault::WrongType: return "wrong type";
+    case WireFault::BadLength: return "bad length";
+    case WireFault::TrailingBytes: return "trailing bytes";
+    case WireFault::DecoderFailed: return "decoder failed";
+    case WireFault::BadChannel: return "bad channel";
+    case WireFault::WrongChannel: return "wrong channel";
+  }
+  return "?";
+}
+
+namespace {
+
+using wire::Field;
+using wire::Kind;
+
+// Big-endian integers at a cursor that never reads past the end.
+class Cursor {
+ public:
+  explicit Cursor(std::span<const std::byte> bytes) : bytes_(bytes) {}
+  std::size_t offset() const { return pos_; }
+  std::size_t left() const { return bytes_.size() - pos_; }
+  std::uint64_t read(int size) {  // call only when left() >= size
+    std::uint64_t v = 0;
+    for (int i = 0; i < size; ++i) v = (v << 8) | std::to_integer<std::uint64_t>(bytes_[pos_++]);
+    return v;
+  }
+  void skip(std::size_t n) { pos_ += n; }
+
+ private:
+  std::span<const std::byte> bytes_;
+  std::size_t pos_ = 0;
+};
+
+int element_size(Kind kind) {
+  switch (kind) {
+    case Kind::I8: return 1;
+    case Kind::I32: return 4;
+    default: return 8;
+  }
+}
+
+bool is_string(Kind kind) { return kind == Kind::Name || kind == Kind::Label || kind == Kind::Text; }
+
+std::unexpected<WireRejection> reject(WireFault fault, std::string detail) {
+  return std::unexpected(WireRejection{fault, std::move(detail)});
+}
+
+// Walks the fields as lcm-gen encodes them; every length is checked against what is left.
+std::expected<void, WireRejection> walk(const wire::Layout& layout, std::span<const std::byte> bytes) {
+  Cursor c(bytes);
+  if (c.left() < 8)
+    return reject(WireFault::Truncated, fmt::format("{} bytes: shorter than the 8-byte type fingerprint", bytes.size()));
+  if (const std::uint64_t fingerprint = c.read(8); fingerprint != layout.fingerprint)
+    return reject(WireFault::WrongType, fmt::format("fingerprint {:016x} is not {}'s ({:016x})", fingerprint,
+                                                    layout.type, layout.fingerprint));
+  std::int64_t last_int32 = 0;  // the length of a byte array that follows
+  for (const Field& f : layout.fields) {
+    const std::size_t at = c.offset();
+    if (is_string(f.kind) || f.kind == Kind::Bytes) {
+      std::int64_t length = last_int32;
+      if (f.kind != Kind::Bytes) {
+        if (c.left() < 4)
+          return reject(WireFault::Truncated, fmt::format("string '{}' at byte {}: its length is cut off", f.name, at));
+        length = static_cast<std::int32_t>(c.read(4));
+        // LCM counts a string's terminating NUL: 0 or less is no string (and what made
+        // LCM's decoder throw).
+        if (length <= 0)
+          return reject(WireFault::BadLength, fmt::format("string '{}' at byte {}: length {}", f.name, at, length));
+      }
+      if (length < 0)
+        return reject(WireFault::BadLength, fmt::format("array '{}' at byte {}: length {}", f.name, at, length));
+      if (static_cast<std::uint64_t>(length) > c.left())
+        return reject(WireFault::BadLength, fmt::format("{} '{}' at byte {}: length {}, only {} bytes left",
+                                                        f.kind == Kind::Bytes ? "array" : "string", f.name, at,
+                                                        length, c.left()));
+      // LCM strings are C strings: the first NUL must be the last byte counted, or the
+      // message would decode to another string than the one it re-encodes to.
+      if (f.kind != Kind::Bytes) {
+        const auto text = bytes.subspan(c.offset(), static_cast<std::size_t>(length));
+        const auto nul = std::find(text.begin(), text.end(), std::byte{0});
+        if (nul != text.end() - 1)
+          return reject(WireFault::BadLength, fmt::format("string '{}' at byte {}: length {}, but its first NUL is {}",
+                                                          f.name, at, length,
+                                                          nul == text.end() ? std::string("missing")
+                                                                            : fmt::format("at byte {}", c.offset() + (nul - text.begin()))));
+      }
+      c.skip(static_cast<std::size_t>(length));
+      continue;
+    }
+    const std::size_t size = static_cast<std::size_t>(element_size(f.kind)) * f.count;
+    if (c.left() < size)
+      return reject(WireFault::Truncated,
+                    fmt::format("field '{}' at byte {}: needs {} bytes, {} left", f.name, at, size, c.left()));
+    if (f.kind == Kind::I32) last_int32 = static_cast<std::int32_t>(c.read(4));
+    else c.skip(size);
+  }
+  if (c.left() > 0)
+    return reject(WireFault::TrailingBytes, fmt::format("{} bytes after the last field of {} (at byte {})", c.left(),
+                                                        layout.type, c.offset()));
+  return {};
+}
+
+}  // namespace
+
+template <typename Msg>
+Decoded<Msg> decode_message(std::span<const std::byte> bytes) {
+  if (bytes.size() > static_cast<std::size_t>(INT_MAX))
+    return reject(WireFault::BadLength, fmt::format("{} bytes: more than LCM's decoder takes", bytes.size()));
+  if (auto walked = walk(wire::layout_of<Msg>(), bytes); !walked) return std::unexpected(walked.error());
+  Msg msg;
+  const int size = static_cast<int>(bytes.size());
+  try {  // the walk leaves nothing for it to throw on; this is the second line of defence
+    if (const int n = msg.decode(bytes.data(), 0, size); n != size)
+      return reject(WireFault::DecoderFailed, fmt::format("LCM's decoder returned {} for {} bytes", n, size));
+  } catch (const std::exception& e) {
+    return reject(WireFault::DecoderFailed, fmt::format("LCM's decoder threw: {}", e.what()));
+  }
+  return msg;
+}
+
+template Decoded<pose_cov_t> decode_message(std::span<const std::byte>);
+template Decoded<truth_pose_t> decode_message(std::span<const std::byte>);
+template Decoded<device_status_t> decode_message(std::span<const std::byte>);
+template Decoded<raw_bytes_t> decode_message(std::span<const std::byte>);
+template Decoded<image_t> decode_message(std::span<const std::byte>);
+
+}  // namespace covtrack

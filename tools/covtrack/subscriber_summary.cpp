@@ -1,0 +1,16 @@
+#include "subscriber_summary.hpp"
+
+#include <fmt/format.h>
+
+namespace covtrack::cli {
+
+std::string subscriber_summary(const client::Subscriber& subscriber, const std::string& prefix) {
+  std::string out;
+  for (const auto& s : subscriber.streams())
+    out += fmt::format("{}{}: received {}, lost {}, rejected {}\n", prefix, s.id.key(), s.counters.received,
+                       s.counters.lost, s.counters.rejected);
+  out += fmt::format("{}rejected messages: {}\n", prefix, subscriber.rejections().summary());
+  return out;
+}
+
+}  // namespace covtrack::cli
