@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "covtrack/protocol/channels.hpp"
+#include "covtrack/protocol/wire_text.hpp"
 
 namespace covtrack {
 namespace {
@@ -13,7 +14,7 @@ std::unexpected<WireRejection> reject(WireFault fault, std::string detail) {
 
 std::unexpected<WireRejection> bad_channel(std::string_view channel, std::string_view shape) {
   return reject(WireFault::BadChannel, fmt::format("channel '{}' is not {} with names of 1-{} characters "
-                                                   "of A-Z a-z 0-9 _ -", channel, shape, kMaxNameLength));
+                                                   "of A-Z a-z 0-9 _ -", printable(channel), shape, kMaxNameLength));
 }
 
 // Decodes a message of a channel `prefix<device>[/<sensor>]` and checks that its names are the channel's.

@@ -2,7 +2,15 @@
 
 #include <fmt/format.h>
 
+#include "covtrack/protocol/wire_text.hpp"
+
 namespace covtrack {
+
+void RejectionTally::add(const std::string& reason, const std::string& channel, const std::string& description) {
+  ++total;
+  ++by_reason[reason];
+  last = printable(channel) + ": " + description;
+}
 
 std::string RejectionTally::summary() const {
   if (total == 0) return "0";

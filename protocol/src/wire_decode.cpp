@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "covtrack/protocol/channels.hpp"
+#include "covtrack/protocol/wire_text.hpp"
 #include "wire_layout.hpp"
 
 namespace covtrack {
@@ -17,6 +19,8 @@ const char* to_string(WireFault fault) {
     case WireFault::WrongType: return "wrong type";
     case WireFault::BadLength: return "bad length";
     case WireFault::TrailingBytes: return "trailing bytes";
+    case WireFault::BadName: return "bad name";
+    case WireFault::BadText: return "bad text";
     case WireFault::DecoderFailed: return "decoder failed";
     case WireFault::BadChannel: return "bad channel";
     case WireFault::WrongChannel: return "wrong channel";
@@ -56,6 +60,22 @@ int element_size(Kind kind) {
 }
 
 bool is_string(Kind kind) { return kind == Kind::Name || kind == Kind::Label || kind == Kind::Text; }
+
+// What is wrong with a string field's text, by its kind of field.
+std::optional<std::pair<WireFault, std::string>> check_text(const Field& f, std::string_view text) {
+  if (f.kind == Kind::Name) {
+    if (is_valid_name(text)) return std::nullopt;
+    return std::pair{WireFault::BadName, fmt::format("'{}' is not 1-{} characters of A-Z a-z 0-9 _ -",
+                                                     printable(text), kMaxNameLength)};
+  }
+  if (const auto at = invalid_utf8_at(text))
+    return std::pair{WireFault::BadText, fmt::format("'{}' is not UTF-8 (at its byte {})", printable(text), *at)};
+  if (f.kind == Kind::Label)
+    if (const auto at = control_character_at(text))
+      return std::pair{WireFault::BadText,
+                       fmt::format("'{}' holds a control character (at its byte {})", printable(text), *at)};
+  return std::nullopt;
+}
 
 std::unexpected<WireRejection> reject(WireFault fault, std::string detail) {
   return std::unexpected(WireRejection{fault, std::move(detail)});
@@ -99,6 +119,11 @@ std::expected<void, WireRejection> walk(const wire::Layout& layout, std::span<co
                                                           f.name, at, length,
                                                           nul == text.end() ? std::string("missing")
                                                                             : fmt::format("at byte {}", c.offset() + (nul - text.begin()))));
+      }
+      if (f.kind != Kind::Bytes) {
+        const std::string_view text(reinterpret_cast<const char*>(bytes.data() + c.offset()),
+                                    static_cast<std::size_t>(length - 1));
+        if (auto bad = check_text(f, text)) return reject(bad->first, fmt::format("string '{}' at byte {}: {}", f.name, at, bad->second));
       }
       c.skip(static_cast<std::size_t>(length));
       continue;

@@ -199,18 +199,22 @@ TEST_F(SubscriberTest, MalformedMessagesAreCountedByReasonAndGoodOnesStillArrive
   auto wrong_type = good;
   wrong_type[0] ^= 0x01;
   lcm_->publish(pose_channel("dev", "s"), wrong_type.data(), static_cast<unsigned>(wrong_type.size()));
+  auto not_utf8 = pose_message("dev", "s", 0);
+  not_utf8.parent_frame = "w\xff";  // ended `covtrack echo --json` (nlohmann type_error.316)
+  publish(not_utf8);
   const std::uint8_t garbage[] = {1, 2, 3};
   lcm_->publish("covtrack/pose/not a stream", garbage, sizeof garbage);  // counted, yet no stream's
   lcm_->publish(status_channel("dev"), garbage, sizeof garbage);          // a heartbeat's turn
   publish(pose_message("dev", "s", 1));
-  ASSERT_TRUE(eventually([&] { return received("dev", "s") == 1 && sub_->rejections().total == 5; }));
+  ASSERT_TRUE(eventually([&] { return received("dev", "s") == 1 && sub_->rejections().total == 6; }));
   const RejectionTally tally = sub_->rejections();
   EXPECT_EQ(tally.by_reason.at("bad length"), 2);
   EXPECT_EQ(tally.by_reason.at("wrong type"), 1);
   EXPECT_EQ(tally.by_reason.at("bad channel"), 1);
   EXPECT_EQ(tally.by_reason.at("truncated"), 1);
+  EXPECT_EQ(tally.by_reason.at("bad text"), 1);
   EXPECT_NE(tally.last.find("covtrack/status/dev"), std::string::npos) << tally.last;
-  EXPECT_EQ(counters("dev", "s").rejected, 3);
+  EXPECT_EQ(counters("dev", "s").rejected, 4);
   EXPECT_EQ(counters("dev", "s").lost, 0);  // the malformed ones told nothing of the sequence
   EXPECT_EQ(sub_->streams().size(), 1u);
   EXPECT_TRUE(sub_->device_statuses().empty());

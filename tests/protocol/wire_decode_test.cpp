@@ -13,6 +13,7 @@
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/pose_message.hpp"
 #include "covtrack/protocol/wire_decode.hpp"
+#include "covtrack/protocol/wire_text.hpp"
 #include "wire_layout.hpp"  // protocol/src: the layouts are internal
 
 using namespace covtrack;
@@ -205,6 +206,38 @@ TEST(WireDecode, RandomMutationsAreRejectedOrDecodeToWhatReEncodesToTheSameBytes
   // Most flips land in numbers (still a message), many in lengths and fingerprints.
   EXPECT_GT(accepted, 1000);
   EXPECT_GT(rejected, 1000);
+}
+
+TEST(WireDecode, NamesMustFollowTheNamingRulesAndTextMustBeUtf8) {
+  for (const std::string& device : {std::string(""), std::string("a b"), std::string(24, 'd'),
+                                     std::string("caf\xc3\xa9"), std::string("x\xff")}) {
+    const auto d = decode_message<pose_cov_t>(encode(pose(device)));
+    ASSERT_FALSE(d) << printable(device);
+    EXPECT_EQ(d.error().fault, WireFault::BadName) << d.error().describe();
+    EXPECT_EQ(invalid_utf8_at(d.error().detail), std::nullopt) << "the detail is printable";
+  }
+  for (const std::string& frame : {std::string("w\xff"), std::string("\xc0\xaf"), std::string("w\x1b[2J"),
+                                   std::string("w\xc2\x9b")}) {
+    auto m = pose();
+    m.parent_frame = frame;
+    const auto d = decode_message<pose_cov_t>(encode(m));
+    ASSERT_FALSE(d) << printable(frame);
+    EXPECT_EQ(d.error().fault, WireFault::BadText);
+    EXPECT_NE(d.error().detail.find("'parent_frame'"), std::string::npos) << d.error().detail;
+    EXPECT_FALSE(control_character_at(d.error().detail)) << d.error().detail;
+  }
+  auto m = pose();
+  m.child_frame = "Kopf \xc3\xa9";  // any UTF-8 without control characters is a frame
+  EXPECT_TRUE(decode_message<pose_cov_t>(encode(m)));
+
+  auto s = status();
+  s.last_error = "line 1\nline 2\ttab";  // free text may hold control characters...
+  EXPECT_TRUE(decode_message<device_status_t>(encode(s)));
+  s.last_error = "bad \xe2\x82";  // ...but must be UTF-8
+  EXPECT_EQ(decode_message<device_status_t>(encode(s)).error().fault, WireFault::BadText);
+  s = status();
+  s.driver = "sim\n";
+  EXPECT_EQ(decode_message<device_status_t>(encode(s)).error().fault, WireFault::BadText);
 }
 
 TEST(ChannelMessages, NamesMustBeTheChannels) {

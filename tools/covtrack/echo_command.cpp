@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/protocol/clock.hpp"
+#include "covtrack/protocol/wire_text.hpp"
 #include "stop_signal.hpp"
 #include "subscriber_summary.hpp"
 
@@ -113,8 +114,8 @@ std::string table(const client::Subscriber& sub, RateMeter& rates) {
   for (const auto& [device, st] : sub.device_statuses())
     out += fmt::format("device {:<20} {:>7.1f} Hz reports {:>9} errors {:>4} drops {:>4} restarts {:>3}{}{}\n",
                        device, st.rate_hz, st.reports, st.errors, st.drops, st.restarts,
-                       st.detail.empty() ? "" : "  (" + st.detail + ")",
-                       st.last_error.empty() ? "" : "  last error: " + st.last_error);
+                       st.detail.empty() ? "" : "  (" + printable(st.detail) + ")",
+                       st.last_error.empty() ? "" : "  last error: " + printable(st.last_error));
   return out;
 }
 
@@ -130,7 +131,8 @@ int run_echo(const EchoOptions& o) {
   // Runs on the subscriber's dispatch thread, the only writer of stdout in --json mode.
   (void)(*sub)->on_pose(".*", [&](const client::TrackedTransform& t) {
     if (o.count > 0 && seen >= o.count) return;
-    if (o.json) std::cout << to_json(t).dump() << "\n" << std::flush;
+    // The wire checks let only UTF-8 through; `replace` keeps a slip there from ending echo.
+    if (o.json) std::cout << to_json(t).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n" << std::flush;
     ++seen;
   });
   const bool tty = ::isatty(STDOUT_FILENO);

@@ -12,11 +12,8 @@ struct RejectionTally {
   std::map<std::string, std::int64_t> by_reason;  // a short reason: "bad length", "invalid pose", ...
   std::string last;                               // channel and full description of the latest
 
-  void add(const std::string& reason, const std::string& channel, const std::string& description) {
-    ++total;
-    ++by_reason[reason];
-    last = channel + ": " + description;
-  }
+  // The channel came from the wire too: it is kept in printable() form.
+  void add(const std::string& reason, const std::string& channel, const std::string& description);
   // "3 (bad length 2, wrong type 1); last: covtrack/pose/a/b: bad length: ..."
   std::string summary() const;
 };

@@ -5,8 +5,9 @@
 // throw std::length_error (the process ends), an array length makes it allocate before it
 // checks the size. Every covtrack program decodes through here instead: the bytes are
 // walked field by field first (type fingerprint, every string and array length inside the
-// message, nothing after the last field), and only then handed to LCM's decoder, whose
-// failures are caught as well. A message that fails is rejected with a fault and a
+// message, nothing after the last field, names and text by their rules), and only then
+// handed to LCM's decoder, whose failures are caught as well. A message that passes
+// holds only valid UTF-8, so JSON and terminals can take its strings as they are. A message that fails is rejected with a fault and a
 // detail saying which field, where; protocol/README.md, "Receiving", lists the checks.
 #include <cstddef>
 #include <expected>
@@ -28,6 +29,8 @@ enum class WireFault {
   WrongType,      // the fingerprint is not the type the channel carries
   BadLength,      // a string or array length that is negative, zero for a string, or past the end
   TrailingBytes,  // bytes after the last field
+  BadName,        // a device or sensor name that breaks the naming rules (channels.hpp)
+  BadText,        // a string that is not UTF-8, or a frame, driver or encoding name with a control character
   DecoderFailed,  // LCM's decoder refused or threw (after the walk found nothing)
   BadChannel,     // a covtrack channel whose name breaks the rules (protocol/README.md, "Messages")
   WrongChannel,   // the message names another device or sensor than its channel
