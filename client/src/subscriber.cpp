@@ -9,13 +9,14 @@
 #include <thread>
 
 #include "covtrack/client/pose_validation.hpp"
+#include "covtrack/client/sequence_tracker.hpp"
 #include "covtrack/protocol/channel_messages.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 
 namespace covtrack::client {
 namespace {
-// How often, at the least, the dispatch thread wakes to mark streams stale.
+// How often, at the least, the dispatch thread wakes to check streams and devices for silence.
 constexpr int kStaleCheckMs = 20;
 // Heartbeats come once per second per device; this only absorbs a burst at start-up.
 constexpr int kStatusQueueCapacity = 1000;
@@ -36,12 +37,6 @@ struct Callback {
 // Replaced, never modified, so the dispatch thread can call a snapshot without a lock.
 using CallbackList = std::vector<Callback>;
 
-// Counts the sequence numbers skipped before `sequence`. A sequence going backwards is a
-// daemon restart (it starts again at 0): the count restarts, it is no loss.
-std::int64_t skipped_before(std::int64_t last_sequence, std::int64_t sequence) {
-  if (last_sequence < 0 || sequence <= last_sequence) return 0;
-  return sequence - last_sequence - 1;
-}
 }  // namespace
 
 struct Subscriber::Impl {
@@ -51,10 +46,11 @@ struct Subscriber::Impl {
   int wake_fd = -1;
   std::jthread thread;
 
-  mutable std::mutex mutex;  // guards streams, statuses and rejections
+  mutable std::mutex mutex;  // guards streams, devices and rejections
   struct Stream {
+    explicit Stream(std::int64_t window) : sequence(window) {}
     StreamState state;
-    std::int64_t last_sequence = -1;  // of the last decoded message, accepted or not
+    SequenceTracker sequence;  // fed every decoded message, accepted or not
     std::int64_t last_accept_us = 0;
     // The callbacks whose pattern matches this stream, for `matched_for`: regex matching
     // once per stream and callback list, not once per message.
@@ -62,7 +58,7 @@ struct Subscriber::Impl {
     std::vector<const Subscriber::PoseCallback*> matched;
   };
   std::map<std::string, Stream> streams;  // by "device/sensor"
-  std::map<std::string, device_status_t> statuses;
+  std::map<std::string, DeviceTracker> devices;  // by device name
   RejectionTally rejections;  // every rejected message, of any channel
 
   std::mutex callbacks_mutex;
@@ -99,18 +95,25 @@ struct Subscriber::Impl {
     std::vector<const PoseCallback*> to_call;
     {
       std::lock_guard lock(mutex);
-      Stream& s = streams[id->key()];
+      Stream& s = streams.try_emplace(id->key(), options.sequence_window).first->second;
       s.state.id = *id;
       // A decoded message names this stream (decode_pose checks it), so its sequence
       // number counts even if its values are rejected: it arrived, it is no loss.
+      auto order = SequenceTracker::Verdict::First;
       if (decoded) {
-        s.state.counters.lost += skipped_before(s.last_sequence, decoded->sequence);
-        s.last_sequence = decoded->sequence;
+        const auto r = s.sequence.classify(decoded->sequence);
+        order = r.verdict;
+        s.state.counters.lost += r.lost;
+        s.state.counters.restarts += order == SequenceTracker::Verdict::Restart;
       }
       if (rejection) {
         ++s.state.counters.rejected;
         s.state.last_rejection = rejection->second;
         rejections.add(rejection->first, channel, rejection->second);
+        return;
+      }
+      if (order == SequenceTracker::Verdict::Foreign) {
+        ++s.state.counters.foreign;
         return;
       }
       s.last_accept_us = now;
@@ -132,20 +135,25 @@ struct Subscriber::Impl {
   }
 
   void on_status_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-    auto decoded = decode_status(channel, bytes_of(rbuf->data, rbuf->data_size));
+    const std::int64_t now = now_us();
+    const auto decoded = decode_status(channel, bytes_of(rbuf->data, rbuf->data_size));
     if (!decoded) return reject_unowned(channel, decoded.error());
     std::lock_guard lock(mutex);
-    statuses[decoded->device] = std::move(*decoded);
+    devices[decoded->device].on_heartbeat(*decoded, now);
   }
 
-  void mark_stale() {
-    const std::int64_t limit = now_us() - static_cast<std::int64_t>(options.stale_after_s * 1e6);
+  // Streams without a message for stale_after_s are stale; devices without a heartbeat
+  // for their DeviceTracker::kMissedHeartbeats periods unreachable.
+  void check_silence() {
+    const std::int64_t now = now_us();
+    const std::int64_t limit = now - static_cast<std::int64_t>(options.stale_after_s * 1e6);
     std::lock_guard lock(mutex);
     for (auto& [key, s] : streams)
       if (!s.state.stale && s.last_accept_us > 0 && s.last_accept_us < limit) {
         s.state.stale = true;
         ++s.state.counters.stale;
       }
+    for (auto& [name, device] : devices) device.check(now);
   }
 
   // LCM's handle() cannot be interrupted: poll its descriptor together with wake_fd,
@@ -158,7 +166,7 @@ struct Subscriber::Impl {
       if (n > 0 && (fds[0].revents & POLLIN)) lcm->handle();
       // At high rates poll() never times out: check staleness on a clock, not per wake-up.
       if (const std::int64_t now = now_us(); now >= next_stale_check) {
-        mark_stale();
+        check_silence();
         next_stale_check = now + kStaleCheckMs * 1000;
       }
     }
@@ -232,7 +240,16 @@ std::vector<StreamState> Subscriber::streams() const {
 
 std::map<std::string, device_status_t> Subscriber::device_statuses() const {
   std::lock_guard lock(impl_->mutex);
-  return impl_->statuses;
+  std::map<std::string, device_status_t> out;
+  for (const auto& [name, device] : impl_->devices) out.emplace(name, device.state().status);
+  return out;
+}
+
+std::map<std::string, DeviceState> Subscriber::devices() const {
+  std::lock_guard lock(impl_->mutex);
+  std::map<std::string, DeviceState> out;
+  for (const auto& [name, device] : impl_->devices) out.emplace(name, device.state());
+  return out;
 }
 
 RejectionTally Subscriber::rejections() const {

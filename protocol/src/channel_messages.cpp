@@ -1,5 +1,7 @@
 #include "covtrack/protocol/channel_messages.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "covtrack/protocol/channels.hpp"
@@ -7,6 +9,9 @@
 
 namespace covtrack {
 namespace {
+
+constexpr std::int64_t kMinHeartbeatPeriodUs = 1'000;
+constexpr std::int64_t kMaxHeartbeatPeriodUs = 3'600'000'000;
 
 std::unexpected<WireRejection> reject(WireFault fault, std::string detail) {
   return std::unexpected(WireRejection{fault, std::move(detail)});
@@ -44,7 +49,16 @@ Decoded<pose_cov_t> decode_pose(std::string_view channel, std::span<const std::b
 }
 
 Decoded<device_status_t> decode_status(std::string_view channel, std::span<const std::byte> bytes) {
-  return decode_named<device_status_t>(channel, bytes, kStatusPrefix, false);
+  auto msg = decode_named<device_status_t>(channel, bytes, kStatusPrefix, false);
+  if (!msg) return msg;
+  if (msg->state < device_status_t::STATE_STARTING || msg->state > device_status_t::STATE_STOPPED)
+    return reject(WireFault::BadValue, fmt::format("unknown state {}", msg->state));
+  if (!std::isfinite(msg->rate_hz) || msg->rate_hz < 0)
+    return reject(WireFault::BadValue, fmt::format("rate_hz {} is not a rate", msg->rate_hz));
+  if (msg->heartbeat_period_us < kMinHeartbeatPeriodUs || msg->heartbeat_period_us > kMaxHeartbeatPeriodUs)
+    return reject(WireFault::BadValue, fmt::format("heartbeat_period_us {} is outside {}-{}", msg->heartbeat_period_us,
+                                                   kMinHeartbeatPeriodUs, kMaxHeartbeatPeriodUs));
+  return msg;
 }
 
 Decoded<image_t> decode_image(std::string_view channel, std::span<const std::byte> bytes) {

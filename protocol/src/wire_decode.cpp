@@ -22,6 +22,7 @@ const char* to_string(WireFault fault) {
     case WireFault::BadName: return "bad name";
     case WireFault::BadText: return "bad text";
     case WireFault::DecoderFailed: return "decoder failed";
+    case WireFault::BadValue: return "bad value";
     case WireFault::BadChannel: return "bad channel";
     case WireFault::WrongChannel: return "wrong channel";
   }

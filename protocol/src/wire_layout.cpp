@@ -26,6 +26,7 @@ constexpr Field kStatus[] = {
     {"time_us", Kind::I64}, {"device", Kind::Name},    {"driver", Kind::Label}, {"state", Kind::I8},
     {"rate_hz", Kind::F64}, {"reports", Kind::I64},    {"errors", Kind::I64},   {"resyncs", Kind::I64},
     {"drops", Kind::I64},   {"restarts", Kind::I64},   {"last_error", Kind::Text}, {"detail", Kind::Text},
+    {"instance_id", Kind::I64}, {"host", Kind::Label}, {"pid", Kind::I32}, {"heartbeat_period_us", Kind::I64},
 };
 
 constexpr Field kRaw[] = {
@@ -53,7 +54,7 @@ const Layout& layout_of<truth_pose_t>() {
 }
 template <>
 const Layout& layout_of<device_status_t>() {
-  static const Layout l{"device_status_t", 0x6c3c8d1b1a671120, kStatus};
+  static const Layout l{"device_status_t", 0x7ec722603176c7fd, kStatus};
   return l;
 }
 template <>

@@ -4,7 +4,9 @@
 // is rejected with its fault, never thrown.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <climits>
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -44,6 +46,10 @@ device_status_t status(const std::string& device = "dev") {
   s.driver = "sim";
   s.last_error = "";
   s.detail = "no tag in view";
+  s.instance_id = 0x1234567890abcdef;
+  s.host = "lab-pc";
+  s.pid = 4242;
+  s.heartbeat_period_us = 1'000'000;
   return s;
 }
 
@@ -125,7 +131,11 @@ TEST(WireDecode, StringLengthOfZeroOrLessIsRejectedNotThrown) {
   }
   for (std::int32_t length : {0, -1}) {  // the last string of a heartbeat too
     auto bytes = encode(status());
-    const std::size_t detail_at = bytes.size() - (4 + std::strlen("no tag in view") + 1);
+    const char* text = "no tag in view";  // detail's characters, after its 4-byte length
+    const auto found = std::search(bytes.begin(), bytes.end(), reinterpret_cast<const std::byte*>(text),
+                                   reinterpret_cast<const std::byte*>(text) + std::strlen(text));
+    ASSERT_NE(found, bytes.end());
+    const std::size_t detail_at = static_cast<std::size_t>(found - bytes.begin()) - 4;
     put_int32(bytes, detail_at, length);
     const auto d = decode_message<device_status_t>(bytes);
     ASSERT_FALSE(d);
@@ -255,6 +265,22 @@ TEST(ChannelMessages, NamesMustBeTheChannels) {
   }
   EXPECT_TRUE(decode_status("covtrack/status/dev", encode(status("dev"))));
   EXPECT_EQ(decode_status("covtrack/status/other", encode(status("dev"))).error().fault, WireFault::WrongChannel);
+}
+
+TEST(ChannelMessages, HeartbeatValuesMustBeInRange) {
+  const auto bad = [](auto change) {
+    auto s = status();
+    change(s);
+    const auto d = decode_status("covtrack/status/dev", encode(s));
+    return d ? std::string("accepted") : d.error().describe();
+  };
+  EXPECT_EQ(bad([](device_status_t&) {}), "accepted");
+  EXPECT_EQ(bad([](device_status_t& s) { s.state = 9; }), "bad value: unknown state 9");
+  EXPECT_EQ(bad([](device_status_t& s) { s.rate_hz = NAN; }), "bad value: rate_hz nan is not a rate");
+  EXPECT_EQ(bad([](device_status_t& s) { s.rate_hz = -1; }), "bad value: rate_hz -1 is not a rate");
+  EXPECT_EQ(bad([](device_status_t& s) { s.heartbeat_period_us = 0; }),
+            "bad value: heartbeat_period_us 0 is outside 1000-3600000000");
+  EXPECT_EQ(bad([](device_status_t& s) { s.host = "pc\x1b"; }).substr(0, 8), "bad text");
 }
 
 TEST(ChannelMessages, CheckOfAnyChannelKnowsEachKindAndLeavesOthersAlone) {

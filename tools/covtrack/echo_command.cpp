@@ -79,7 +79,21 @@ class RateMeter {
   std::map<std::string, std::pair<std::int64_t, double>> last_;
 };
 
-constexpr const char* kRowFormat = "{:<28} {:>8} {:>26} {:>9} {:>9} {:<8} {:>6} {:>6} {:<5} {:>5}\n";
+constexpr const char* kRowFormat = "{:<28} {:>8} {:>26} {:>9} {:>9} {:<8} {:>6} {:>6} {:>7} {:>7} {:<5} {:>5}\n";
+
+// One device's heartbeat: its counters, who publishes it, and what its heartbeats reveal.
+std::string device_line(const std::string& name, const client::DeviceState& d) {
+  const device_status_t& st = d.status;
+  std::string line = fmt::format("device {:<20} {:>7.1f} Hz reports {:>9} errors {:>4} drops {:>4} restarts {:>3}  "
+                                 "from {}:{}", name, st.rate_hz, st.reports, st.errors, st.drops, st.restarts,
+                                 st.host, st.pid);
+  if (d.publishers > 1)
+    line += fmt::format("  {} PUBLISHERS (another daemon publishes this device)", d.publishers);
+  if (d.restarts > 0) line += fmt::format("  daemon restarted {} time(s)", d.restarts);
+  if (!st.detail.empty()) line += "  (" + printable(st.detail) + ")";
+  if (!st.last_error.empty()) line += "  last error: " + printable(st.last_error);
+  return line + "\n";
+}
 
 double steady_now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -87,7 +101,8 @@ double steady_now_s() {
 
 std::string table(const client::Subscriber& sub, RateMeter& rates) {
   std::string out = fmt::format(fmt::runtime(kRowFormat), "stream", "rate Hz", "position m (x y z)",
-                                "σpos mm", "σrot deg", "status", "lost", "reject", "stale", "times");
+                                "σpos mm", "σrot deg", "status", "lost", "reject", "foreign", "restart", "stale",
+                                "times");
   const double now_s = steady_now_s();
   for (const auto& s : sub.streams()) {
     const double rate = rates.update(s.id.key(), s.counters.received, now_s);
@@ -104,18 +119,16 @@ std::string table(const client::Subscriber& sub, RateMeter& rates) {
       }
     }
     out += fmt::format(fmt::runtime(kRowFormat), s.id.key(), fmt::format("{:.1f}", rate), position, sp,
-                       sr, status, s.counters.lost, s.counters.rejected, s.stale ? "STALE" : "",
-                       s.counters.stale);
+                       sr, status, s.counters.lost, s.counters.rejected, s.counters.foreign, s.counters.restarts,
+                       s.stale ? "STALE" : "", s.counters.stale);
   }
   out += "σ: 1-sigma along the worst direction (sqrt of the largest eigenvalue of the 3x3 "
-         "position / rotation block, BODY frame); stale times: how often it went stale\n";
+         "position / rotation block, BODY frame); foreign: messages off the stream's sequence "
+         "(a second publisher, forged, duplicate); restart: the sequence started again; stale "
+         "times: how often it went stale\n";
   if (const RejectionTally rejected = sub.rejections(); rejected.total > 0)
     out += "rejected messages: " + rejected.summary() + "\n";
-  for (const auto& [device, st] : sub.device_statuses())
-    out += fmt::format("device {:<20} {:>7.1f} Hz reports {:>9} errors {:>4} drops {:>4} restarts {:>3}{}{}\n",
-                       device, st.rate_hz, st.reports, st.errors, st.drops, st.restarts,
-                       st.detail.empty() ? "" : "  (" + printable(st.detail) + ")",
-                       st.last_error.empty() ? "" : "  last error: " + printable(st.last_error));
+  for (const auto& [name, device] : sub.devices()) out += device_line(name, device);
   return out;
 }
 

@@ -7,8 +7,9 @@ namespace covtrack::cli {
 std::string subscriber_summary(const client::Subscriber& subscriber, const std::string& prefix) {
   std::string out;
   for (const auto& s : subscriber.streams())
-    out += fmt::format("{}{}: received {}, lost {}, rejected {}\n", prefix, s.id.key(), s.counters.received,
-                       s.counters.lost, s.counters.rejected);
+    out += fmt::format("{}{}: received {}, lost {}, rejected {}, foreign {}, restarts {}\n", prefix, s.id.key(),
+                       s.counters.received, s.counters.lost, s.counters.rejected, s.counters.foreign,
+                       s.counters.restarts);
   out += fmt::format("{}rejected messages: {}\n", prefix, subscriber.rejections().summary());
   return out;
 }

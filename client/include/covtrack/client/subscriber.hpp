@@ -30,6 +30,7 @@
 #include <covtrack/device_status_t.hpp>
 #include <lcm/lcm-cpp.hpp>
 
+#include "covtrack/client/device_tracker.hpp"
 #include "covtrack/client/tracked_transform.hpp"
 #include "covtrack/protocol/rejection_tally.hpp"
 #include "covtrack/protocol/result.hpp"
@@ -43,12 +44,20 @@ struct SubscriberOptions {
   // LCM drops the newest message silently when a subscription's queue is full (default
   // 30); this is that queue's length, large enough for a burst of several seconds.
   int queue_capacity = 100000;
+  // The largest forward jump of a stream's sequence still counted as loss; beyond it, or
+  // backwards, a message is off the stream's track (SequenceTracker).
+  std::int64_t sequence_window = 1000;
 };
 
+// Every message on a stream's channel is received, rejected or foreign, exactly one.
 struct StreamCounters {
-  std::int64_t received = 0;  // accepted messages
-  std::int64_t lost = 0;      // sequence numbers skipped (a sequence going back = restart, not loss)
+  std::int64_t received = 0;  // accepted and delivered
+  std::int64_t lost = 0;      // sequence numbers skipped by a forward jump within sequence_window
   std::int64_t rejected = 0;  // malformed or invalid messages (never delivered)
+  // Valid messages off the stream's sequence (a duplicate, a second publisher's, a forged
+  // one; and the SequenceTracker::kConfirm - 1 before a restart is followed): never delivered.
+  std::int64_t foreign = 0;
+  std::int64_t restarts = 0;  // times the stream's sequence started again (a daemon restart)
   std::int64_t stale = 0;     // times the stream went stale
 };
 
@@ -88,6 +97,8 @@ class Subscriber {
   std::vector<StreamState> streams() const;  // ordered by device/sensor
   // The last heartbeat (covtrack/status/<device>) of each device, by device name.
   std::map<std::string, device_status_t> device_statuses() const;
+  // Each device as its heartbeats tell it (reachable, publishers, restarts), by name.
+  std::map<std::string, DeviceState> devices() const;
   // Every message rejected so far (poses, heartbeats, channels that name no stream).
   RejectionTally rejections() const;
 

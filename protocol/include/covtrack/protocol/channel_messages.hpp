@@ -11,7 +11,8 @@ namespace covtrack {
 
 // covtrack/pose/<device>/<sensor>
 Decoded<pose_cov_t> decode_pose(std::string_view channel, std::span<const std::byte> bytes);
-// covtrack/status/<device>
+// covtrack/status/<device>; also its values: a known state, a finite rate >= 0, a
+// heartbeat period of 1 ms to 1 h (a client's unreachable timer depends on it).
 Decoded<device_status_t> decode_status(std::string_view channel, std::span<const std::byte> bytes);
 // covtrack/image/<device>
 Decoded<image_t> decode_image(std::string_view channel, std::span<const std::byte> bytes);

@@ -32,6 +32,7 @@ enum class WireFault {
   BadName,        // a device or sensor name that breaks the naming rules (channels.hpp)
   BadText,        // a string that is not UTF-8, or a frame, driver or encoding name with a control character
   DecoderFailed,  // LCM's decoder refused or threw (after the walk found nothing)
+  BadValue,       // a heartbeat field out of its range (state, rate, period)
   BadChannel,     // a covtrack channel whose name breaks the rules (protocol/README.md, "Messages")
   WrongChannel,   // the message names another device or sensor than its channel
 };
