@@ -4,6 +4,7 @@
 #include <sys/eventfd.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <mutex>
 #include <regex>
 #include <thread>
@@ -121,17 +122,23 @@ struct Subscriber::Impl {
       ++s.state.counters.received;
       s.state.latest = to_tracked_transform(*decoded, now);
       accepted = s.state.latest;
-      if (s.matched_for != current_callbacks) {
-        s.matched.clear();
-        for (const auto& cb : *current_callbacks)
-          if (std::regex_match(id->key(), cb.pattern)) s.matched.push_back(&cb.function);
-        s.matched_for = current_callbacks;
-      }
-      to_call = s.matched;
+      to_call = matching_callbacks(s, current_callbacks);
     }
     // Outside the lock: a callback may read latest() or register another callback.
     // current_callbacks keeps the functions alive while they run.
     for (const PoseCallback* cb : to_call) (*cb)(*accepted);
+  }
+
+  // The callbacks of `current` whose pattern matches the stream (call with mutex held).
+  static const std::vector<const PoseCallback*>& matching_callbacks(
+      Stream& s, const std::shared_ptr<const CallbackList>& current) {
+    if (s.matched_for != current) {
+      s.matched.clear();
+      for (const auto& cb : *current)
+        if (std::regex_match(s.state.id.key(), cb.pattern)) s.matched.push_back(&cb.function);
+      s.matched_for = current;
+    }
+    return s.matched;
   }
 
   void on_status_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
@@ -142,18 +149,42 @@ struct Subscriber::Impl {
     devices[decoded->device].on_heartbeat(*decoded, now);
   }
 
-  // Streams without a message for stale_after_s are stale; devices without a heartbeat
-  // for their DeviceTracker::kMissedHeartbeats periods unreachable.
+  // Streams without a message for stale_after_s are stale. A device without a heartbeat
+  // for DeviceTracker::kMissedHeartbeats periods is unreachable: its streams are reported
+  // LOST, through latest() and the callbacks, so a dead daemon is told from a quiet one.
   void check_silence() {
     const std::int64_t now = now_us();
     const std::int64_t limit = now - static_cast<std::int64_t>(options.stale_after_s * 1e6);
-    std::lock_guard lock(mutex);
-    for (auto& [key, s] : streams)
-      if (!s.state.stale && s.last_accept_us > 0 && s.last_accept_us < limit) {
-        s.state.stale = true;
-        ++s.state.counters.stale;
+    const auto current_callbacks = callback_snapshot();
+    std::vector<std::pair<TrackedTransform, std::vector<const PoseCallback*>>> to_call;
+    {
+      std::lock_guard lock(mutex);
+      for (auto& [key, s] : streams)
+        if (!s.state.stale && s.last_accept_us > 0 && s.last_accept_us < limit) {
+          s.state.stale = true;
+          ++s.state.counters.stale;
+        }
+      for (auto& [name, device] : devices) {
+        if (!device.check(now)) continue;
+        for (auto& [key, s] : streams)
+          if (s.state.id.device == name && s.state.latest && !s.state.latest->device_unreachable) {
+            s.state.latest = unreachable(*s.state.latest, now);
+            to_call.emplace_back(*s.state.latest, matching_callbacks(s, current_callbacks));
+          }
       }
-    for (auto& [name, device] : devices) device.check(now);
+    }
+    for (const auto& [report, callbacks] : to_call)
+      for (const PoseCallback* cb : callbacks) (*cb)(report);
+  }
+
+  // The last report of a stream whose device is unreachable, made LOST.
+  static TrackedTransform unreachable(TrackedTransform last, std::int64_t now) {
+    last.status = TrackingStatus::Lost;
+    last.covariance = Mat6::Zero();
+    last.covariance.diagonal().setConstant(INFINITY);  // as a LOST message arrives (TrackedTransform)
+    last.receive_time_us = now;
+    last.device_unreachable = true;
+    return last;
   }
 
   // LCM's handle() cannot be interrupted: poll its descriptor together with wake_fd,

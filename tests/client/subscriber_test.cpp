@@ -316,6 +316,37 @@ TEST_F(SubscriberTest, DeviceHeartbeatsAreKeptPerDevice) {
   EXPECT_EQ(sub_->device_statuses().size(), 2u);
 }
 
+TEST_F(SubscriberTest, QuietDeviceStaysReachableAndSilentOneIsReportedLost) {
+  open({.stale_after_s = 0.05});
+  std::atomic<int> unreachable_reports{0};
+  ASSERT_TRUE(sub_->on_pose(".*", [&](const client::TrackedTransform& t) { unreachable_reports += t.device_unreachable; }));
+  device_status_t st{};
+  st.device = "dev";
+  st.heartbeat_period_us = 100'000;  // unreachable after 0.3 s without one: far beyond the 10 ms pace below
+  publish(pose_message("dev", "s", 0));
+  // Quiet: heartbeats go on, no pose. The stream goes stale; the device stays reachable.
+  for (int i = 0; i < 30; ++i) {
+    lcm_->publish(status_channel("dev"), &st);
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(eventually([&] { return sub_->stream({"dev", "s"})->stale; }));
+  EXPECT_TRUE(sub_->devices().at("dev").reachable);
+  EXPECT_EQ(unreachable_reports, 0);
+  EXPECT_FALSE(sub_->latest({"dev", "s"})->lost());
+  // Dead: the heartbeats stop too.
+  ASSERT_TRUE(eventually([&] { return unreachable_reports == 1; }));
+  EXPECT_FALSE(sub_->devices().at("dev").reachable);
+  EXPECT_TRUE(sub_->latest({"dev", "s"})->lost());
+  EXPECT_TRUE(sub_->latest({"dev", "s"})->device_unreachable);
+  EXPECT_EQ(sub_->latest({"dev", "s"})->sequence, 0);  // the last message's, not a new one
+  // Back: a heartbeat makes it reachable; the next pose replaces the LOST report.
+  lcm_->publish(status_channel("dev"), &st);
+  publish(pose_message("dev", "s", 1));
+  ASSERT_TRUE(eventually([&] { return received("dev", "s") == 2; }));
+  EXPECT_TRUE(sub_->devices().at("dev").reachable);
+  EXPECT_FALSE(sub_->latest({"dev", "s"})->device_unreachable);
+}
+
 TEST_F(SubscriberTest, StopsPromptlyWhenIdleAndDeliversNothingAfter) {
   std::atomic<int> calls{0};
   ASSERT_TRUE(sub_->on_pose(".*", [&](const client::TrackedTransform&) { ++calls; }));

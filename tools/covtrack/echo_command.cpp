@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/protocol/clock.hpp"
+#include "covtrack/protocol/lcm_url.hpp"
 #include "covtrack/protocol/wire_text.hpp"
 #include "stop_signal.hpp"
 #include "subscriber_summary.hpp"
@@ -49,7 +50,8 @@ nlohmann::json to_json(const client::TrackedTransform& t) {
       {"position_m", {t.T_parent_child.translation().x(), t.T_parent_child.translation().y(),
                       t.T_parent_child.translation().z()}},
       {"orientation_wxyz", {q.w(), q.x(), q.y(), q.z()}},
-      {"covariance_convention", "BODY"}};
+      {"covariance_convention", "BODY"},
+      {"device_unreachable", t.device_unreachable}};
   if (t.lost()) {
     j["covariance"] = nullptr;  // infinite: JSON has no infinity
   } else {
@@ -79,6 +81,9 @@ class RateMeter {
   std::map<std::string, std::pair<std::int64_t, double>> last_;
 };
 
+// How long echo waits for a first message before it says that nothing arrives.
+constexpr std::chrono::seconds kSilenceHint{3};
+
 constexpr const char* kRowFormat = "{:<28} {:>8} {:>26} {:>9} {:>9} {:<8} {:>6} {:>6} {:>7} {:>7} {:<5} {:>5}\n";
 
 // One device's heartbeat: its counters, who publishes it, and what its heartbeats reveal.
@@ -87,6 +92,9 @@ std::string device_line(const std::string& name, const client::DeviceState& d) {
   std::string line = fmt::format("device {:<20} {:>7.1f} Hz reports {:>9} errors {:>4} drops {:>4} restarts {:>3}  "
                                  "from {}:{}", name, st.rate_hz, st.reports, st.errors, st.drops, st.restarts,
                                  st.host, st.pid);
+  if (!d.reachable)
+    line += fmt::format("  UNREACHABLE: no heartbeat for {:.1f} s, its streams LOST",
+                        1e-6 * static_cast<double>(now_us() - d.last_heard_us));
   if (d.publishers > 1)
     line += fmt::format("  {} PUBLISHERS (another daemon publishes this device)", d.publishers);
   if (d.restarts > 0) line += fmt::format("  daemon restarted {} time(s)", d.restarts);
@@ -148,6 +156,9 @@ int run_echo(const EchoOptions& o) {
     if (o.json) std::cout << to_json(t).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n" << std::flush;
     ++seen;
   });
+  // With no daemon on this URL echo would wait in silence: say so once, on stderr.
+  const auto hint_at = std::chrono::steady_clock::now() + kSilenceHint;
+  bool hinted = false;
   const bool tty = ::isatty(STDOUT_FILENO);
   const auto start = std::chrono::steady_clock::now();
   auto next_table = start + std::chrono::milliseconds(tty ? 200 : 1000);
@@ -162,6 +173,14 @@ int run_echo(const EchoOptions& o) {
     const auto now = std::chrono::steady_clock::now();
     if (o.count > 0 && seen >= o.count) break;
     if (o.duration_s > 0 && now - start >= std::chrono::duration<double>(o.duration_s)) break;
+    if (!hinted && now >= hint_at) {
+      hinted = true;
+      if ((*sub)->streams().empty() && (*sub)->devices().empty())
+        std::cerr << fmt::format("covtrack echo: nothing received for {} s on {} (streams '{}'): is covtrackd "
+                                 "running and publishing there? (covtrackd --config config/sim.toml)\n",
+                                 kSilenceHint.count(), effective_lcm_url(o.subscriber.lcm_url),
+                                 o.subscriber.pattern);
+    }
     if (!o.json && now >= next_table) {
       next_table += std::chrono::milliseconds(tty ? 200 : 1000);
       print_table();

@@ -20,6 +20,11 @@
 // semi-definite. LOST messages skip the covariance checks: see TrackedTransform.
 // Heartbeats are checked the same way (decode_status()). Every rejection is counted by
 // its reason in rejections(); those of a stream's channel also in its counters.
+//
+// Silence: a stream without a message for stale_after_s is stale (it keeps its last
+// value). A device whose heartbeats were heard and then stop for 3 of their periods is
+// unreachable (devices()): each of its streams is reported LOST at once, through latest()
+// and the callbacks, with device_unreachable set, until its next message.
 #include <functional>
 #include <map>
 #include <memory>
