@@ -19,6 +19,8 @@ namespace covtrack::client {
 namespace {
 // How often, at the least, the dispatch thread wakes to check streams and devices for silence.
 constexpr int kStaleCheckMs = 20;
+// The longest stop() spends on messages already received.
+constexpr std::int64_t kDrainUs = 200'000;
 // Heartbeats come once per second per device; this only absorbs a burst at start-up.
 constexpr int kStatusQueueCapacity = 1000;
 
@@ -200,6 +202,11 @@ struct Subscriber::Impl {
         check_silence();
         next_stale_check = now + kStaleCheckMs * 1000;
       }
+    }
+    // What LCM had already received when told to stop still counts (a program's summary
+    // at exit covers everything sent before it was stopped); bounded, as a stream never ends.
+    const std::int64_t drain_end = now_us() + kDrainUs;
+    while (now_us() < drain_end && lcm->handleTimeout(0) > 0) {
     }
   }
 };

@@ -107,8 +107,9 @@ class Subscriber {
   // Every message rejected so far (poses, heartbeats, channels that name no stream).
   RejectionTally rejections() const;
 
-  // Ends the dispatch thread; idempotent, prompt even when no message arrives. After it
-  // no callback runs; latest() and the counters keep their last values.
+  // Ends the dispatch thread, after it has handled what LCM had already received (for at
+  // most 0.2 s); idempotent, prompt when no message arrives. After it no callback runs;
+  // latest() and the counters keep their last values.
   void stop();
 
  private:
