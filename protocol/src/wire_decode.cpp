@@ -82,6 +82,21 @@ std::unexpected<WireRejection> reject(WireFault fault, std::string detail) {
   return std::unexpected(WireRejection{fault, std::move(detail)});
 }
 
+// A string field's bytes (`body`, its NUL included) that start at byte `at`. LCM strings
+// are C strings: the first NUL must be the last byte, or the message would decode to
+// another string than the one it re-encodes to.
+std::expected<void, WireRejection> check_string(const Field& f, std::span<const std::byte> body, std::size_t at) {
+  const auto nul = std::find(body.begin(), body.end(), std::byte{0});
+  if (nul != body.end() - 1)
+    return reject(WireFault::BadLength,
+                  fmt::format("string '{}' at byte {}: length {}, but its first NUL is {}", f.name, at, body.size(),
+                              nul == body.end() ? "missing" : fmt::format("its byte {}", nul - body.begin())));
+  const std::string_view text(reinterpret_cast<const char*>(body.data()), body.size() - 1);
+  if (auto bad = check_text(f, text))
+    return reject(bad->first, fmt::format("string '{}' at byte {}: {}", f.name, at, bad->second));
+  return {};
+}
+
 // Walks the fields as lcm-gen encodes them; every length is checked against what is left.
 std::expected<void, WireRejection> walk(const wire::Layout& layout, std::span<const std::byte> bytes) {
   Cursor c(bytes);
@@ -93,48 +108,30 @@ std::expected<void, WireRejection> walk(const wire::Layout& layout, std::span<co
   std::int64_t last_int32 = 0;  // the length of a byte array that follows
   for (const Field& f : layout.fields) {
     const std::size_t at = c.offset();
-    if (is_string(f.kind) || f.kind == Kind::Bytes) {
-      std::int64_t length = last_int32;
-      if (f.kind != Kind::Bytes) {
-        if (c.left() < 4)
-          return reject(WireFault::Truncated, fmt::format("string '{}' at byte {}: its length is cut off", f.name, at));
-        length = static_cast<std::int32_t>(c.read(4));
-        // LCM counts a string's terminating NUL: 0 or less is no string (and what made
-        // LCM's decoder throw).
-        if (length <= 0)
-          return reject(WireFault::BadLength, fmt::format("string '{}' at byte {}: length {}", f.name, at, length));
-      }
-      if (length < 0)
-        return reject(WireFault::BadLength, fmt::format("array '{}' at byte {}: length {}", f.name, at, length));
-      if (static_cast<std::uint64_t>(length) > c.left())
-        return reject(WireFault::BadLength, fmt::format("{} '{}' at byte {}: length {}, only {} bytes left",
-                                                        f.kind == Kind::Bytes ? "array" : "string", f.name, at,
-                                                        length, c.left()));
-      // LCM strings are C strings: the first NUL must be the last byte counted, or the
-      // message would decode to another string than the one it re-encodes to.
-      if (f.kind != Kind::Bytes) {
-        const auto text = bytes.subspan(c.offset(), static_cast<std::size_t>(length));
-        const auto nul = std::find(text.begin(), text.end(), std::byte{0});
-        if (nul != text.end() - 1)
-          return reject(WireFault::BadLength, fmt::format("string '{}' at byte {}: length {}, but its first NUL is {}",
-                                                          f.name, at, length,
-                                                          nul == text.end() ? std::string("missing")
-                                                                            : fmt::format("at byte {}", c.offset() + (nul - text.begin()))));
-      }
-      if (f.kind != Kind::Bytes) {
-        const std::string_view text(reinterpret_cast<const char*>(bytes.data() + c.offset()),
-                                    static_cast<std::size_t>(length - 1));
-        if (auto bad = check_text(f, text)) return reject(bad->first, fmt::format("string '{}' at byte {}: {}", f.name, at, bad->second));
-      }
+    if (is_string(f.kind)) {
+      if (c.left() < 4)
+        return reject(WireFault::Truncated, fmt::format("string '{}' at byte {}: its length is cut off", f.name, at));
+      const std::int64_t length = static_cast<std::int32_t>(c.read(4));
+      // LCM counts a string's NUL: 0 or less is no string (and made LCM's decoder throw).
+      if (length <= 0 || static_cast<std::uint64_t>(length) > c.left())
+        return reject(WireFault::BadLength,
+                      fmt::format("string '{}' at byte {}: length {}, {} bytes left", f.name, at, length, c.left()));
+      if (auto bad = check_string(f, bytes.subspan(c.offset(), static_cast<std::size_t>(length)), at); !bad)
+        return std::unexpected(bad.error());
       c.skip(static_cast<std::size_t>(length));
-      continue;
+    } else if (f.kind == Kind::Bytes) {
+      if (last_int32 < 0 || static_cast<std::uint64_t>(last_int32) > c.left())
+        return reject(WireFault::BadLength,
+                      fmt::format("array '{}' at byte {}: length {}, {} bytes left", f.name, at, last_int32, c.left()));
+      c.skip(static_cast<std::size_t>(last_int32));
+    } else {
+      const std::size_t size = static_cast<std::size_t>(element_size(f.kind)) * f.count;
+      if (c.left() < size)
+        return reject(WireFault::Truncated,
+                      fmt::format("field '{}' at byte {}: needs {} bytes, {} left", f.name, at, size, c.left()));
+      if (f.kind == Kind::I32) last_int32 = static_cast<std::int32_t>(c.read(4));
+      else c.skip(size);
     }
-    const std::size_t size = static_cast<std::size_t>(element_size(f.kind)) * f.count;
-    if (c.left() < size)
-      return reject(WireFault::Truncated,
-                    fmt::format("field '{}' at byte {}: needs {} bytes, {} left", f.name, at, size, c.left()));
-    if (f.kind == Kind::I32) last_int32 = static_cast<std::int32_t>(c.read(4));
-    else c.skip(size);
   }
   if (c.left() > 0)
     return reject(WireFault::TrailingBytes, fmt::format("{} bytes after the last field of {} (at byte {})", c.left(),
