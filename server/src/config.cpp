@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "covtrack/protocol/channels.hpp"
+#include "covtrack/protocol/wire_text.hpp"
 
 namespace covtrack::server {
 namespace {
@@ -85,6 +86,10 @@ void read_devices(TableReader& top, DaemonConfig& out) {
       top.errors().add(top.file(), node.source(), path, "expected a table [devices." + name + "]");
       continue;
     }
+    // Clients reject a pose whose frame name holds a control character (protocol/README.md).
+    if (const auto* frame = (*table)["parent_frame"].as_string(); frame && control_character_at(frame->get()))
+      top.errors().add(top.file(), frame->source(), path + ".parent_frame",
+                       "must hold no control character (clients would reject every pose)");
     const DriverType* type = read_type(*table, path, top.file(), top.errors());
     if (!type) continue;
     TableReader r(*table, path, *type->specs.front(), top.file(), top.errors());

@@ -7,6 +7,7 @@
 
 #include "covtrack/devices/interruptible_sleep.hpp"
 #include "covtrack/protocol/clock.hpp"
+#include "covtrack/protocol/wire_text.hpp"
 
 namespace covtrack::server {
 namespace {
@@ -124,8 +125,10 @@ device_status_t DeviceRunner::heartbeat() {
   s.restarts = restarts_;
   {
     std::lock_guard lock(text_mutex_);
-    s.last_error = last_error_;
-    s.detail = detail_;
+    // An error message may quote bytes a device sent; clients reject a heartbeat whose
+    // text is not UTF-8 (protocol/README.md), so they go out escaped.
+    s.last_error = printable(last_error_);
+    s.detail = printable(detail_);
   }
   reports_at_last_heartbeat_ = reports;
   last_heartbeat_ = now;

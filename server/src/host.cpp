@@ -29,8 +29,16 @@ void Host::stop() {
 void Host::publish_heartbeats(std::stop_token stop) {
   using namespace std::chrono;
   const auto period = duration_cast<steady_clock::duration>(duration<double>(1.0 / settings_.heartbeat_hz));
+  const auto period_us = duration_cast<microseconds>(period).count();
   for (auto next = steady_clock::now() + period; sleep_until(stop, next); next += period)
-    for (auto& r : runners_) publisher_.status(r->heartbeat());
+    for (auto& r : runners_) {
+      device_status_t status = r->heartbeat();
+      status.instance_id = identity_.instance_id;
+      status.host = identity_.host;
+      status.pid = identity_.pid;
+      status.heartbeat_period_us = period_us;
+      publisher_.status(status);
+    }
 }
 
 }  // namespace covtrack::server

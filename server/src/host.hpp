@@ -9,6 +9,7 @@
 #include "config.hpp"
 #include "device_runner.hpp"
 #include "publisher.hpp"
+#include "publisher_identity.hpp"
 
 namespace covtrack::server {
 
@@ -25,6 +26,7 @@ class Host {
   void publish_heartbeats(std::stop_token stop);
 
   DaemonSettings settings_;
+  PublisherIdentity identity_ = PublisherIdentity::of_this_process();
   Publisher publisher_;
   std::vector<std::unique_ptr<DeviceRunner>> runners_;
   std::jthread heartbeat_thread_;

@@ -34,6 +34,8 @@ class DaemonProcess {
     }
   }
 
+  pid_t pid() const { return pid_; }
+
   // Sends the signal; returns the seconds until the process exited (or -1 after 5 s)
   // and its exit status through `status`.
   double stop(int signal, int& status) {
