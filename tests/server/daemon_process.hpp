@@ -1,5 +1,6 @@
 #pragma once
 // Starts covtrackd as a separate process for end-to-end tests, and stops it with a signal.
+#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -7,8 +8,10 @@
 
 #include <chrono>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -27,6 +30,23 @@ class DaemonProcess {
       _exit(127);
     }
   }
+  // covtrackd with exactly these arguments; its stdout and stderr go to `output_path`.
+  DaemonProcess(const std::vector<std::string>& args, const std::string& output_path) {
+    pid_ = fork();
+    if (pid_ == 0) {
+      const int out = ::open(output_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (out >= 0) {
+        dup2(out, STDOUT_FILENO);
+        dup2(out, STDERR_FILENO);
+      }
+      const std::string exe = COVTRACK_BINARY_DIR "/server/covtrackd";
+      std::vector<char*> argv{const_cast<char*>(exe.c_str())};
+      for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+      argv.push_back(nullptr);
+      execv(exe.c_str(), argv.data());
+      _exit(127);
+    }
+  }
   ~DaemonProcess() {
     if (pid_ > 0 && !exited_) {
       kill(pid_, SIGKILL);
@@ -39,15 +59,28 @@ class DaemonProcess {
   double stop(int signal, int& status) {
     const auto t0 = std::chrono::steady_clock::now();
     kill(pid_, signal);
-    while (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5)) {
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        exited_ = true;
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    if (auto ended = wait(5.0)) {
+      status = *ended;
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     return -1;
   }
+
+  // Waits up to `seconds` for the process to end; its exit status, or nothing.
+  std::optional<int> wait(double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    int status = 0;
+    while (std::chrono::steady_clock::now() < end) {
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        exited_ = true;
+        return status;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return std::nullopt;
+  }
+
+  pid_t pid() const { return pid_; }
 
  private:
   std::string config_path_;

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <hidapi/hidapi.h>
 
+#include "covtrack/devices/file_kind.hpp"
 #include "covtrack/devices/hydra/hydra_report.hpp"
 #include "covtrack/devices/valid_frame_watchdog.hpp"
 #include "covtrack/protocol/clock.hpp"
@@ -36,6 +37,9 @@ class HydraDriver final : public Driver {
     if (path.empty())
       return fail("Razer Hydra: device not found (USB 1532:0300, interface 0): is it plugged in, "
                   "and may this user open /dev/hidraw* (udev rule)?");
+    // hidapi opens whatever it is given, in blocking mode; only a hidraw node (a character
+    // device) can be a Hydra, and a FIFO or a file there is named here instead.
+    if (auto kind = require_character_device(path, "Razer Hydra: hid_path"); !kind) return kind;
     hid_device* dev = hid_open_path(path.c_str());
     if (!dev) return fail(fmt::format("Razer Hydra: cannot open {} (permissions?)", path));
     auto result = stream(dev, sink, stop);
