@@ -8,12 +8,15 @@
 
 #include <chrono>
 #include <fstream>
+#include <functional>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include <lcm/lcm-cpp.hpp>
+
+#include <covtrack/device_status_t.hpp>
 
 namespace covtrack::test {
 
@@ -96,5 +99,26 @@ inline void handle_for(lcm::LCM& lcm, double seconds) {
   while (std::chrono::steady_clock::now() < end)
     if (poll(&pfd, 1, 20) > 0) lcm.handle();
 }
+
+// Keeps the latest heartbeat of one device.
+class StatusWatch {
+ public:
+  StatusWatch(const std::string& url, const std::string& device) : lcm_(url) {
+    lcm_.subscribe("covtrack/status/" + device, &StatusWatch::on_status, this);
+  }
+  // Handles heartbeats until one satisfies `done` or `seconds` passed; the latest one.
+  std::optional<device_status_t> until(const std::function<bool(const device_status_t&)>& done, double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    pollfd pfd{lcm_.getFileno(), POLLIN, 0};
+    while (std::chrono::steady_clock::now() < end && !(last_ && done(*last_)))
+      if (poll(&pfd, 1, 20) > 0) lcm_.handle();
+    return last_;
+  }
+
+ private:
+  void on_status(const lcm::ReceiveBuffer*, const std::string&, const device_status_t* m) { last_ = *m; }
+  lcm::LCM lcm_;
+  std::optional<device_status_t> last_;
+};
 
 }  // namespace covtrack::test

@@ -10,7 +10,6 @@
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
-#include <poll.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -22,7 +21,6 @@
 #include <thread>
 
 #include <fmt/format.h>
-#include <lcm/lcm-cpp.hpp>
 
 #include <covtrack/device_status_t.hpp>
 
@@ -63,27 +61,6 @@ int writer_once_read(const std::string& fifo) {
   return -1;
 }
 
-// Keeps the latest heartbeat of one device.
-class StatusWatch {
- public:
-  StatusWatch(const std::string& url, const std::string& device) : lcm_(url) {
-    lcm_.subscribe("covtrack/status/" + device, &StatusWatch::on_status, this);
-  }
-  // Handles heartbeats until one says FAILED or 20 s passed; the last heartbeat.
-  std::optional<device_status_t> until_failed() {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-    pollfd pfd{lcm_.getFileno(), POLLIN, 0};
-    while (std::chrono::steady_clock::now() < end && !(last_ && last_->state == device_status_t::STATE_FAILED))
-      if (poll(&pfd, 1, 20) > 0) lcm_.handle();
-    return last_;
-  }
-
- private:
-  void on_status(const lcm::ReceiveBuffer*, const std::string&, const device_status_t* m) { last_ = *m; }
-  lcm::LCM lcm_;
-  std::optional<device_status_t> last_;
-};
-
 class FifoSource : public ::testing::TestWithParam<std::string> {};
 
 }  // namespace
@@ -106,9 +83,10 @@ id = 0
 size_m = 0.1
 )",
                                          fifo, COVTRACK_SOURCE_DIR);
-  StatusWatch watch(url, "cam");
+  test::StatusWatch watch(url, "cam");
   test::DaemonProcess daemon(config, url);
-  const auto status = watch.until_failed();
+  const auto status =
+      watch.until([](const device_status_t& s) { return s.state == device_status_t::STATE_FAILED; }, 20);
   ASSERT_TRUE(status) << "no heartbeat from the device";
   EXPECT_EQ(int{status->state}, int{device_status_t::STATE_FAILED});
   EXPECT_NE(status->last_error.find(fifo + "' is a FIFO (named pipe), not a regular file"), std::string::npos)
