@@ -12,7 +12,7 @@ void say(const char (&text)[N]) {
 }
 
 // Only async-signal-safe calls: write, raise. SA_RESETHAND has already restored the
-// default action, so the raised signal ends the process once this returns.
+// default action, so the raised signal ends the process (at once, or when this returns).
 extern "C" void end_now(int signal) {
   if (signal == SIGINT) say("covtrackd: SIGINT before the devices started; nothing was started\n");
   else say("covtrackd: SIGTERM before the devices started; nothing was started\n");

@@ -20,15 +20,6 @@ FileKind kind_of(mode_t mode) {
   return FileKind::Other;
 }
 
-Result<void> require(const std::string& path, std::string_view what, FileKind wanted) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0)
-    return fail(fmt::format("{} '{}' cannot be used: {}", what, path, std::strerror(errno)));
-  const FileKind kind = kind_of(st.st_mode);
-  if (kind == wanted) return {};
-  return fail(fmt::format("{} '{}' is {}, not {}", what, path, describe(kind), describe(wanted)));
-}
-
 }  // namespace
 
 FileKind file_kind(const std::string& path) {
@@ -51,12 +42,13 @@ std::string_view describe(FileKind kind) {
   return "?";
 }
 
-Result<void> require_regular_file(const std::string& path, std::string_view what) {
-  return require(path, what, FileKind::Regular);
-}
-
 Result<void> require_character_device(const std::string& path, std::string_view what) {
-  return require(path, what, FileKind::CharacterDevice);
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0)
+    return fail(fmt::format("{} '{}' cannot be used: {}", what, path, std::strerror(errno)));
+  const FileKind kind = kind_of(st.st_mode);
+  if (kind == FileKind::CharacterDevice) return {};
+  return fail(fmt::format("{} '{}' is {}, not a character device", what, path, describe(kind)));
 }
 
 }  // namespace covtrack

@@ -17,8 +17,7 @@ FileKind file_kind(const std::string& path);
 // "a FIFO (named pipe)", "a folder", ...
 std::string_view describe(FileKind kind);
 
-// Errors read "<what> '<path>' is a FIFO (named pipe), not a regular file".
-Result<void> require_regular_file(const std::string& path, std::string_view what);
+// An error "<what> '<path>' is a FIFO (named pipe), not a character device" unless it is one.
 Result<void> require_character_device(const std::string& path, std::string_view what);
 
 }  // namespace covtrack
