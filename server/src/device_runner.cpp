@@ -59,10 +59,25 @@ DeviceRunner::~DeviceRunner() {
 }
 
 void DeviceRunner::start() {
-  thread_ = std::jthread([this](std::stop_token stop) { supervise(stop); });
+  thread_ = std::jthread([this](std::stop_token stop) {
+    supervise(stop);
+    std::lock_guard lock(finished_mutex_);
+    finished_ = true;
+    finished_cv_.notify_all();
+  });
 }
 
 void DeviceRunner::request_stop() { thread_.request_stop(); }
+
+bool DeviceRunner::join_until(std::chrono::steady_clock::time_point deadline) {
+  if (!thread_.joinable()) return true;
+  {
+    std::unique_lock lock(finished_mutex_);
+    if (!finished_cv_.wait_until(lock, deadline, [this] { return finished_; })) return false;
+  }
+  thread_.join();
+  return true;
+}
 
 void DeviceRunner::join() {
   if (thread_.joinable()) thread_.join();

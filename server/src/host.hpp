@@ -1,6 +1,7 @@
 #pragma once
 // Hosts every configured device and publishes their heartbeats.
 #include <memory>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -19,8 +20,12 @@ class Host {
   ~Host();
 
   void start();
-  // Stops every device and the heartbeat, and waits for their threads.
-  void stop();
+  // Asks every device and the heartbeat to stop, and waits for each device's thread up
+  // to daemon.stop_timeout_s in all. Returns a line per device whose thread is still
+  // running then ("device 'cam' (fiducial) did not stop within 2.0 s"): its driver is
+  // blocked in a call that ignores the stop request. The Host must then not be
+  // destroyed (it would wait for that thread); the caller ends the process instead.
+  std::vector<std::string> stop();
 
  private:
   void publish_heartbeats(std::stop_token stop);

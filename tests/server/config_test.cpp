@@ -151,6 +151,17 @@ TEST(Config, DisabledDeviceIsValidatedButNotStarted) {
   EXPECT_TRUE(r->devices.empty());
 }
 
+// A device node or a folder is no config: reading one could block or never end (a pipe
+// is read; shutdown_e2e_test).
+TEST(Config, ADeviceOrAFolderIsRefusedAsAConfig) {
+  for (const std::string path : {"/dev/zero", "/tmp"}) {
+    auto r = covtrack::server::load_config(path);
+    ASSERT_FALSE(r) << path;
+    EXPECT_NE(r.error().message.find(path + ": is a "), std::string::npos) << r.error().message;
+    EXPECT_NE(r.error().message.find(", not a file to read"), std::string::npos) << r.error().message;
+  }
+}
+
 TEST(Config, SchemaDocumentIsUpToDate) {
   std::ifstream in(COVTRACK_SOURCE_DIR "/config/schema.md");
   std::stringstream text;
