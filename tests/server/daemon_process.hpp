@@ -85,8 +85,6 @@ class DaemonProcess {
     return std::nullopt;
   }
 
-  pid_t pid() const { return pid_; }
-
  private:
   std::string config_path_;
   pid_t pid_ = -1;
