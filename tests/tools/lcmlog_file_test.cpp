@@ -1,5 +1,7 @@
 // Log files written by LogWriter read back by LogReader, and damaged logs: the reader must
 // deliver every intact event and name the offset where the damage starts.
+#include <sys/stat.h>
+
 #include <filesystem>
 #include <fstream>
 
@@ -79,6 +81,14 @@ TEST_F(LogFileTest, MissingFileIsAClearError) {
   auto reader = LogReader::open((dir_ / "nope.lcmlog").string());
   ASSERT_FALSE(reader);
   EXPECT_NE(reader.error().message.find("No such file"), std::string::npos);
+}
+
+TEST_F(LogFileTest, AFifoIsRefusedWithoutWaitingForAWriter) {
+  const auto fifo = dir_ / "session.lcm";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  auto reader = LogReader::open(fifo.string());  // blocked here before O_NONBLOCK
+  ASSERT_FALSE(reader);
+  EXPECT_NE(reader.error().message.find("not a regular file"), std::string::npos) << reader.error().message;
 }
 
 TEST_F(LogFileTest, TruncatedMidEventReadsAllCompleteEvents) {
