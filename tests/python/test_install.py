@@ -1,0 +1,29 @@
+"""`cmake --install` puts the module where Debian's python3 finds packages
+(<prefix>/lib/python3/dist-packages), and it works from there, outside the build tree."""
+import os
+import pathlib
+import subprocess
+import sys
+
+from conftest import BINARY_DIR
+
+CMAKE = os.environ.get("COVTRACK_CMAKE", "cmake")
+
+
+def test_installed_module_imports_and_reads_a_log(tmp_path, source_dir):
+    prefix = tmp_path / "prefix"
+    run = subprocess.run([CMAKE, "--install", str(BINARY_DIR), "--prefix", str(prefix), "--component", "python"],
+                         capture_output=True, text=True, timeout=60)
+    assert run.returncode == 0, run.stdout + run.stderr
+    site = prefix / "lib" / "python3" / "dist-packages"
+    assert (site / "covtrack" / "__init__.py").is_file()
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONPATH"] = str(site)
+    log = source_dir / "tests" / "data" / "lenz_session.lcm"
+    check = subprocess.run(
+        [sys.executable, "-c",
+         f"import covtrack; print(covtrack.__file__); print(len(covtrack.read_log({str(log)!r}).poses))"],
+        capture_output=True, text=True, timeout=60, env=env, cwd=tmp_path)
+    assert check.returncode == 0, check.stderr
+    where, streams = check.stdout.split()
+    assert pathlib.Path(where).is_relative_to(site) and int(streams) > 0
