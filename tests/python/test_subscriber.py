@@ -48,6 +48,10 @@ def test_mistakes_are_exceptions():
             s.on_pose(42)
         with pytest.raises(ValueError, match="pattern"):
             s.on_pose(print, "(")
+        with pytest.raises(ValueError, match="timeout_s"):
+            s.wait_for("a", "b", timeout_s=-1)
+        with pytest.raises(ValueError, match="timeout_s"):
+            s.wait_for("a", "b", timeout_s=float("nan"))
         assert s.latest("a", "b") is None and s.streams() == [] and s.devices() == {}
 
 

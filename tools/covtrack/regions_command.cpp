@@ -27,16 +27,6 @@ struct RegionsArgs {
   double confidence = 0;  // 0: the scene's
 };
 
-std::vector<std::string> flag_names(const client::ProjectionFlags& f) {
-  std::vector<std::string> names;
-  if (f.behind_camera) names.push_back("behind_camera");
-  if (f.sigma_point_behind_camera) names.push_back("sigma_point_behind_camera");
-  if (f.rotation_too_uncertain) names.push_back("rotation_too_uncertain");
-  if (f.unbounded) names.push_back("unbounded");
-  if (f.covariance_repaired) names.push_back("covariance_repaired");
-  return names;
-}
-
 nlohmann::json polygon_json(const client::Polygon& polygon) {
   nlohmann::json points = nlohmann::json::array();
   for (const client::Vec2& p : polygon) points.push_back({p.x(), p.y()});

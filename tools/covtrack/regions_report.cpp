@@ -15,6 +15,16 @@ Result<RegionsModel> load_regions_model(const std::string& scene_path, double co
   return RegionsModel{scene_path, std::move(*scene), *camera, p, std::move(*objects)};
 }
 
+std::vector<std::string> flag_names(const client::ProjectionFlags& f) {
+  std::vector<std::string> names;
+  if (f.behind_camera) names.push_back("behind_camera");
+  if (f.sigma_point_behind_camera) names.push_back("sigma_point_behind_camera");
+  if (f.rotation_too_uncertain) names.push_back("rotation_too_uncertain");
+  if (f.unbounded) names.push_back("unbounded");
+  if (f.covariance_repaired) names.push_back("covariance_repaired");
+  return names;
+}
+
 Result<RegionsReport> compute_regions(const RegionsModel& model, const client::TransformGraph& graph,
                                       std::int64_t time_us, client::ProjectionMethod method) {
   RegionsReport report{model.camera, model.scene.camera.frame, model.confidence, {}, std::nullopt};

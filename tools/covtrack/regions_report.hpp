@@ -40,6 +40,9 @@ struct RegionsReport {
   std::optional<client::ProjectedVertex> pointer_tip;
 };
 
+// The names of the flags that are set ("behind_camera", ...), as `covtrack regions` prints them.
+std::vector<std::string> flag_names(const client::ProjectionFlags& flags);
+
 // The regions of every object at time_us. Fails naming the object (not the file) if its
 // frame is not connected to the camera's.
 Result<RegionsReport> compute_regions(const RegionsModel& model, const client::TransformGraph& graph,

@@ -50,16 +50,6 @@ Pose rigid(const Eigen::Matrix4d& m) {
   return T;
 }
 
-std::vector<std::string> flag_names(const client::ProjectionFlags& f) {
-  std::vector<std::string> names;
-  if (f.behind_camera) names.push_back("behind_camera");
-  if (f.sigma_point_behind_camera) names.push_back("sigma_point_behind_camera");
-  if (f.rotation_too_uncertain) names.push_back("rotation_too_uncertain");
-  if (f.unbounded) names.push_back("unbounded");
-  if (f.covariance_repaired) names.push_back("covariance_repaired");
-  return names;
-}
-
 py::array_t<double> points_array(const client::Polygon& points) {
   py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{2}});
   auto a = out.mutable_unchecked<2>();
@@ -189,7 +179,7 @@ void bind_scene(py::module_& m) {
                              "every vertex has a pixel and a bounded error: only then do the regions mean anything")
       .def_property_readonly("assessment_px", [](const ObjectResult& o) { return o.regions.assessment; },
                              "the largest semi-axis of the vertices' confidence ellipses; inf when not valid")
-      .def_property_readonly("flags", [](const ObjectResult& o) { return flag_names(o.regions.flags); })
+      .def_property_readonly("flags", [](const ObjectResult& o) { return cli::flag_names(o.regions.flags); })
       .def_property_readonly("vertices_m", [](const ObjectResult& o) {
         Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> v(o.hull_vertices_m.size(), 3);
         for (std::size_t i = 0; i < o.hull_vertices_m.size(); ++i) v.row(i) = o.hull_vertices_m[i].transpose();
@@ -204,7 +194,7 @@ void bind_scene(py::module_& m) {
       }, "(N,) camera z of each vertex")
       .def_property_readonly("vertex_flags", [](const ObjectResult& o) {
         std::vector<std::vector<std::string>> out;
-        for (const auto& v : o.regions.vertices) out.push_back(flag_names(v.flags));
+        for (const auto& v : o.regions.vertices) out.push_back(cli::flag_names(v.flags));
         return out;
       })
       .def_property_readonly("screen_hull", [](const ObjectResult& o) { return o.regions.hull; },

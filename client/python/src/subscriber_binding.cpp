@@ -137,6 +137,9 @@ class PySubscriber {
   // The stream's next accepted report (or its first), or None after timeout_s.
   std::optional<TrackedTransform> wait_for(const std::string& device, const std::string& sensor,
                                            std::optional<double> timeout_s) {
+    open();  // raises when closed
+    if (timeout_s && !(*timeout_s >= 0 && *timeout_s < 1e9))  // also refuses NaN
+      throw py::value_error("timeout_s must be from 0 to 1e9 s, or None");
     const StreamId id{device, sensor};
     const std::string key = id.key();
     const std::int64_t seen = arrivals_->count(key);
