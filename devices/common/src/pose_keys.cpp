@@ -12,7 +12,7 @@ std::vector<KeySpec> pose_keys() {
       {"position_m", ValueType::FloatArray, "m", "[0, 0, 0]", "child origin in the parent frame", -1e6, 1e6, 3},
       {"rotation_rpy_deg", ValueType::FloatArray, "deg", "[0, 0, 0]",
        "roll, pitch, yaw: R = Rz(yaw) Ry(pitch) Rx(roll); or orientation_wxyz", -360, 360, 3},
-      {"orientation_wxyz", ValueType::FloatArray, "", "", "unit quaternion w x y z; instead of rotation_rpy_deg",
+      {"orientation_wxyz", ValueType::FloatArray, "", "(none)", "unit quaternion w x y z; instead of rotation_rpy_deg",
        -1, 1, 4},
   };
 }
