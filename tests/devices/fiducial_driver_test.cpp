@@ -70,14 +70,20 @@ Scene render_sequence(const std::string& name, int frames) {
   return s;
 }
 
-FiducialConfig config_for(const Scene& s) {
+// The frames and camera in `dir`, played once as fast as they are read.
+FiducialConfig sequence_config(const fs::path& dir) {
   FiducialConfig c;
   c.device = "cam";
-  c.source = (s.dir / "frame_%04d.png").string();
-  c.calibration = (s.dir / "camera.yml").string();
+  c.source = (dir / "frame_%04d.png").string();
+  c.calibration = (dir / "camera.yml").string();
   c.detector.decimate = 1;
   c.rate_hz = 0;
   c.loop = false;
+  return c;
+}
+
+FiducialConfig config_for(const Scene& s) {
+  FiducialConfig c = sequence_config(s.dir);
   c.tag_size_m = {{2, 0.1}, {9, 0.1}};
   return c;
 }
@@ -123,13 +129,7 @@ BundleScene render_bundle_sequence(const std::string& name, int frames, int with
 }
 
 FiducialConfig bundle_config_for(const BundleScene& s) {
-  FiducialConfig c;
-  c.device = "cam";
-  c.source = (s.dir / "frame_%04d.png").string();
-  c.calibration = (s.dir / "camera.yml").string();
-  c.detector.decimate = 1;
-  c.rate_hz = 0;
-  c.loop = false;
+  FiducialConfig c = sequence_config(s.dir);
   c.tag_size_m = {{9, 0.08}};
   c.bundles = {board_bundle()};
   return c;
