@@ -4,20 +4,23 @@
 #include <sys/eventfd.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <mutex>
 #include <regex>
 #include <thread>
 
-#include <covtrack/pose_cov_t.hpp>
-
 #include "covtrack/client/pose_validation.hpp"
+#include "covtrack/client/sequence_tracker.hpp"
+#include "covtrack/protocol/channel_messages.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 
 namespace covtrack::client {
 namespace {
-// How often, at the least, the dispatch thread wakes to mark streams stale.
+// How often, at the least, the dispatch thread wakes to check streams and devices for silence.
 constexpr int kStaleCheckMs = 20;
+// The longest stop() spends on messages already received.
+constexpr std::int64_t kDrainUs = 200'000;
 // Heartbeats come once per second per device; this only absorbs a burst at start-up.
 constexpr int kStatusQueueCapacity = 1000;
 
@@ -37,12 +40,6 @@ struct Callback {
 // Replaced, never modified, so the dispatch thread can call a snapshot without a lock.
 using CallbackList = std::vector<Callback>;
 
-// Counts the sequence numbers skipped before `sequence`. A sequence going backwards is a
-// daemon restart (it starts again at 0): the count restarts, it is no loss.
-std::int64_t skipped_before(std::int64_t last_sequence, std::int64_t sequence) {
-  if (last_sequence < 0 || sequence <= last_sequence) return 0;
-  return sequence - last_sequence - 1;
-}
 }  // namespace
 
 struct Subscriber::Impl {
@@ -52,10 +49,11 @@ struct Subscriber::Impl {
   int wake_fd = -1;
   std::jthread thread;
 
-  mutable std::mutex mutex;  // guards streams and statuses
+  mutable std::mutex mutex;  // guards streams, devices and rejections
   struct Stream {
+    explicit Stream(std::int64_t window) : sequence(window) {}
     StreamState state;
-    std::int64_t last_sequence = -1;  // of the last decoded message, accepted or not
+    SequenceTracker sequence;  // fed every decoded message, accepted or not
     std::int64_t last_accept_us = 0;
     // The callbacks whose pattern matches this stream, for `matched_for`: regex matching
     // once per stream and callback list, not once per message.
@@ -63,7 +61,8 @@ struct Subscriber::Impl {
     std::vector<const Subscriber::PoseCallback*> matched;
   };
   std::map<std::string, Stream> streams;  // by "device/sensor"
-  std::map<std::string, device_status_t> statuses;
+  std::map<std::string, DeviceTracker> devices;  // by device name
+  RejectionTally rejections;  // every rejected message, of any channel
 
   std::mutex callbacks_mutex;
   std::shared_ptr<const CallbackList> callbacks = std::make_shared<CallbackList>();
@@ -77,70 +76,117 @@ struct Subscriber::Impl {
     return callbacks;
   }
 
+  // Counts a message that no stream can own: its channel is not a stream's, or a heartbeat.
+  void reject_unowned(const std::string& channel, const WireRejection& why) {
+    std::lock_guard lock(mutex);
+    rejections.add(to_string(why.fault), channel, why.describe());
+  }
+
   void on_pose_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     const std::int64_t now = now_us();
+    const auto decoded = decode_pose(channel, bytes_of(rbuf->data, rbuf->data_size));
     const auto id = parse_pose_channel(channel);
-    if (!id) return;  // matched the regex but is not a well-formed stream name
-    pose_cov_t msg;
-    const bool decoded = msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) >= 0;
-    // Only a message that names this stream tells anything about its sequence numbers.
-    const bool ours = decoded && msg.device == id->device && msg.sensor == id->sensor;
-    std::optional<std::string> reason;
+    if (!id) return reject_unowned(channel, decoded.error());
+    std::optional<std::pair<std::string, std::string>> rejection;  // reason, description
     if (!decoded)
-      reason = "malformed message (" + std::to_string(rbuf->data_size) + " bytes)";
-    else if (!ours)
-      reason = "device/sensor '" + msg.device + "/" + msg.sensor + "' differ from the channel";
-    else
-      reason = rejection_reason(msg);
+      rejection.emplace(to_string(decoded.error().fault), decoded.error().describe());
+    else if (auto invalid = rejection_reason(*decoded))
+      rejection.emplace("invalid pose", *invalid);
 
     const auto current_callbacks = callback_snapshot();
     std::optional<TrackedTransform> accepted;
     std::vector<const PoseCallback*> to_call;
     {
       std::lock_guard lock(mutex);
-      Stream& s = streams[id->key()];
+      Stream& s = streams.try_emplace(id->key(), options.sequence_window).first->second;
       s.state.id = *id;
-      // A rejected message still arrived: its sequence number is no loss.
-      if (ours) {
-        s.state.counters.lost += skipped_before(s.last_sequence, msg.sequence);
-        s.last_sequence = msg.sequence;
+      // A decoded message names this stream (decode_pose checks it), so its sequence
+      // number counts even if its values are rejected: it arrived, it is no loss.
+      auto order = SequenceTracker::Verdict::First;
+      if (decoded) {
+        const auto r = s.sequence.classify(decoded->sequence);
+        order = r.verdict;
+        s.state.counters.lost += r.lost;
+        s.state.counters.restarts += order == SequenceTracker::Verdict::Restart;
       }
-      if (reason) {
+      if (rejection) {
         ++s.state.counters.rejected;
-        s.state.last_rejection = *reason;
+        s.state.last_rejection = rejection->second;
+        rejections.add(rejection->first, channel, rejection->second);
+        return;
+      }
+      if (order == SequenceTracker::Verdict::Foreign) {
+        ++s.state.counters.foreign;
         return;
       }
       s.last_accept_us = now;
       s.state.stale = false;
       ++s.state.counters.received;
-      s.state.latest = to_tracked_transform(msg, now);
+      s.state.latest = to_tracked_transform(*decoded, now);
       accepted = s.state.latest;
-      if (s.matched_for != current_callbacks) {
-        s.matched.clear();
-        for (const auto& cb : *current_callbacks)
-          if (std::regex_match(id->key(), cb.pattern)) s.matched.push_back(&cb.function);
-        s.matched_for = current_callbacks;
-      }
-      to_call = s.matched;
+      to_call = matching_callbacks(s, current_callbacks);
     }
     // Outside the lock: a callback may read latest() or register another callback.
     // current_callbacks keeps the functions alive while they run.
     for (const PoseCallback* cb : to_call) (*cb)(*accepted);
   }
 
-  void on_status(const lcm::ReceiveBuffer*, const std::string&, const device_status_t* msg) {
-    std::lock_guard lock(mutex);
-    statuses[msg->device] = *msg;
+  // The callbacks of `current` whose pattern matches the stream (call with mutex held).
+  static const std::vector<const PoseCallback*>& matching_callbacks(
+      Stream& s, const std::shared_ptr<const CallbackList>& current) {
+    if (s.matched_for != current) {
+      s.matched.clear();
+      for (const auto& cb : *current)
+        if (std::regex_match(s.state.id.key(), cb.pattern)) s.matched.push_back(&cb.function);
+      s.matched_for = current;
+    }
+    return s.matched;
   }
 
-  void mark_stale() {
-    const std::int64_t limit = now_us() - static_cast<std::int64_t>(options.stale_after_s * 1e6);
+  void on_status_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    const std::int64_t now = now_us();
+    const auto decoded = decode_status(channel, bytes_of(rbuf->data, rbuf->data_size));
+    if (!decoded) return reject_unowned(channel, decoded.error());
     std::lock_guard lock(mutex);
-    for (auto& [key, s] : streams)
-      if (!s.state.stale && s.last_accept_us > 0 && s.last_accept_us < limit) {
-        s.state.stale = true;
-        ++s.state.counters.stale;
+    devices[decoded->device].on_heartbeat(*decoded, now);
+  }
+
+  // Streams without a message for stale_after_s are stale. A device without a heartbeat
+  // for DeviceTracker::kMissedHeartbeats periods is unreachable: its streams are reported
+  // LOST, through latest() and the callbacks, so a dead daemon is told from a quiet one.
+  void check_silence() {
+    const std::int64_t now = now_us();
+    const std::int64_t limit = now - static_cast<std::int64_t>(options.stale_after_s * 1e6);
+    const auto current_callbacks = callback_snapshot();
+    std::vector<std::pair<TrackedTransform, std::vector<const PoseCallback*>>> to_call;
+    {
+      std::lock_guard lock(mutex);
+      for (auto& [key, s] : streams)
+        if (!s.state.stale && s.last_accept_us > 0 && s.last_accept_us < limit) {
+          s.state.stale = true;
+          ++s.state.counters.stale;
+        }
+      for (auto& [name, device] : devices) {
+        if (!device.check(now)) continue;
+        for (auto& [key, s] : streams)
+          if (s.state.id.device == name && s.state.latest && !s.state.latest->device_unreachable) {
+            s.state.latest = unreachable(*s.state.latest, now);
+            to_call.emplace_back(*s.state.latest, matching_callbacks(s, current_callbacks));
+          }
       }
+    }
+    for (const auto& [report, callbacks] : to_call)
+      for (const PoseCallback* cb : callbacks) (*cb)(report);
+  }
+
+  // The last report of a stream whose device is unreachable, made LOST.
+  static TrackedTransform unreachable(TrackedTransform last, std::int64_t now) {
+    last.status = TrackingStatus::Lost;
+    last.covariance = Mat6::Zero();
+    last.covariance.diagonal().setConstant(INFINITY);  // as a LOST message arrives (TrackedTransform)
+    last.receive_time_us = now;
+    last.device_unreachable = true;
+    return last;
   }
 
   // LCM's handle() cannot be interrupted: poll its descriptor together with wake_fd,
@@ -153,9 +199,14 @@ struct Subscriber::Impl {
       if (n > 0 && (fds[0].revents & POLLIN)) lcm->handle();
       // At high rates poll() never times out: check staleness on a clock, not per wake-up.
       if (const std::int64_t now = now_us(); now >= next_stale_check) {
-        mark_stale();
+        check_silence();
         next_stale_check = now + kStaleCheckMs * 1000;
       }
+    }
+    // What LCM had already received when told to stop still counts (a program's summary
+    // at exit covers everything sent before it was stopped); bounded, as a stream never ends.
+    const std::int64_t drain_end = now_us() + kDrainUs;
+    while (now_us() < drain_end && lcm->handleTimeout(0) > 0) {
     }
   }
 };
@@ -186,7 +237,7 @@ Result<std::unique_ptr<Subscriber>> Subscriber::attach(std::shared_ptr<lcm::LCM>
   auto* poses = raw->lcm->subscribe(std::string(kPosePrefix) + "(" + options.pattern + ")",
                                     &Impl::on_pose_bytes, raw);
   poses->setQueueCapacity(options.queue_capacity);
-  auto* status = raw->lcm->subscribe(std::string(kStatusPrefix) + ".*", &Impl::on_status, raw);
+  auto* status = raw->lcm->subscribe(std::string(kStatusPrefix) + ".*", &Impl::on_status_bytes, raw);
   status->setQueueCapacity(kStatusQueueCapacity);
   raw->subscriptions = {poses, status};
   raw->thread = std::jthread([raw](std::stop_token stop) { raw->dispatch(stop); });
@@ -227,7 +278,21 @@ std::vector<StreamState> Subscriber::streams() const {
 
 std::map<std::string, device_status_t> Subscriber::device_statuses() const {
   std::lock_guard lock(impl_->mutex);
-  return impl_->statuses;
+  std::map<std::string, device_status_t> out;
+  for (const auto& [name, device] : impl_->devices) out.emplace(name, device.state().status);
+  return out;
+}
+
+std::map<std::string, DeviceState> Subscriber::devices() const {
+  std::lock_guard lock(impl_->mutex);
+  std::map<std::string, DeviceState> out;
+  for (const auto& [name, device] : impl_->devices) out.emplace(name, device.state());
+  return out;
+}
+
+RejectionTally Subscriber::rejections() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->rejections;
 }
 
 void Subscriber::stop() {

@@ -1,20 +1,12 @@
 #include "covtrack/client/transform_graph.hpp"
 
 #include <algorithm>
-#include <set>
+#include <unordered_set>
 
 #include "covtrack/client/graph_chain.hpp"
 #include "covtrack/client/graph_seed_matrix16.hpp"
 
 namespace covtrack::client {
-namespace {
-
-bool binds(const EdgeSource& source, const StreamId& stream) {
-  const auto* tracked = std::get_if<TrackedSource>(&source);
-  return tracked && tracked->stream == stream;
-}
-
-}  // namespace
 
 TransformGraph::TransformGraph(Propagation mode) : mode_(mode) {}
 
@@ -25,14 +17,35 @@ void TransformGraph::set_propagation(Propagation mode) {
 
 bool TransformGraph::has_frame(const std::string& frame) const {
   std::lock_guard lock(mutex_);
-  return frames_.contains(frame);
+  return index_.contains(frame);
 }
 
-std::vector<std::string> TransformGraph::ancestry(const std::string& frame) const {
-  std::vector<std::string> out{frame};
-  for (auto it = frames_.find(frame); it != frames_.end() && it->second.parent;
-       it = frames_.find(*it->second.parent))
-    out.push_back(*it->second.parent);
+std::optional<TransformGraph::FrameIndex> TransformGraph::find(const std::string& frame) const {
+  const auto it = index_.find(frame);
+  if (it == index_.end()) return std::nullopt;
+  return it->second;
+}
+
+TransformGraph::FrameIndex TransformGraph::add_frame(const std::string& frame) {
+  const FrameIndex index = frames_.size();
+  index_.emplace(frame, index);
+  frames_.push_back(Frame{frame, std::nullopt, {}});
+  tree_.push_back(index);  // a tree of its own
+  return index;
+}
+
+// The representative of the frame's tree; path halving keeps the way there short.
+TransformGraph::FrameIndex TransformGraph::tree_of(FrameIndex frame) {
+  while (tree_[frame] != frame) {
+    tree_[frame] = tree_[tree_[frame]];
+    frame = tree_[frame];
+  }
+  return frame;
+}
+
+std::vector<TransformGraph::FrameIndex> TransformGraph::ancestry(FrameIndex frame) const {
+  std::vector<FrameIndex> out{frame};
+  for (auto p = frames_[frame].parent; p; p = frames_[*p].parent) out.push_back(*p);
   return out;
 }
 
@@ -40,18 +53,23 @@ Result<void> TransformGraph::add_edge(const std::string& parent, const std::stri
   std::lock_guard lock(mutex_);
   if (parent.empty() || child.empty()) return fail("transform graph: empty frame name");
   if (parent == child) return fail("transform graph: edge " + parent + " -> " + child + " is a loop");
-  if (auto it = frames_.find(child); it != frames_.end() && it->second.parent)
+  const auto existing_child = find(child), existing_parent = find(parent);
+  if (existing_child && frames_[*existing_child].parent)
     return fail("transform graph: frame '" + child + "' already has parent '" +
-                *it->second.parent + "'; cannot add a second parent '" + parent +
+                frames_[*frames_[*existing_child].parent].name + "'; cannot add a second parent '" + parent +
                 "' (use a combined edge for several sources of one transform)");
-  const auto up = ancestry(parent);
-  if (std::find(up.begin(), up.end(), child) != up.end())
+  // The child has no parent, so it is the root of its tree: the edge closes a cycle exactly
+  // when the parent is in that tree.
+  if (existing_child && existing_parent && tree_of(*existing_child) == tree_of(*existing_parent))
     return fail("transform graph: edge " + parent + " -> " + child +
                 " would close a cycle ('" + child + "' is an ancestor of '" + parent + "')");
-  frames_[parent];  // creates a root if new
-  Frame& c = frames_[child];
-  c.parent = parent;
-  c.edge = std::move(edge);
+  const FrameIndex p = existing_parent ? *existing_parent : add_frame(parent);
+  const FrameIndex c = existing_child ? *existing_child : add_frame(child);
+  tree_[tree_of(c)] = tree_of(p);
+  for (const EdgeSource& source : edge.sources)
+    if (const auto* tracked = std::get_if<TrackedSource>(&source)) ++bound_streams_[tracked->stream.key()];
+  frames_[c].parent = p;
+  frames_[c].edge = std::move(edge);
   return {};
 }
 
@@ -80,19 +98,16 @@ Result<void> TransformGraph::store_report(const StreamId& stream, const TrackedT
 
 Result<void> TransformGraph::update(const StreamId& stream, const TrackedTransform& report) {
   std::lock_guard lock(mutex_);
-  const bool bound = std::any_of(frames_.begin(), frames_.end(), [&](const auto& f) {
-    const auto& s = f.second.edge.sources;
-    return std::any_of(s.begin(), s.end(), [&](const EdgeSource& e) { return binds(e, stream); });
-  });
-  if (!bound) return fail("transform graph: no edge is bound to stream " + stream.key());
+  if (!bound_streams_.contains(stream.key()))
+    return fail("transform graph: no edge is bound to stream " + stream.key());
   return store_report(stream, report);
 }
 
 Result<void> TransformGraph::update(const std::string& edge_child_frame, const TrackedTransform& report) {
   std::lock_guard lock(mutex_);
-  const auto it = frames_.find(edge_child_frame);
-  if (it == frames_.end()) return fail("transform graph: unknown frame '" + edge_child_frame + "'");
-  const Edge& edge = it->second.edge;
+  const auto frame = find(edge_child_frame);
+  if (!frame) return fail("transform graph: unknown frame '" + edge_child_frame + "'");
+  const Edge& edge = frames_[*frame].edge;
   const auto* tracked = edge.sources.size() == 1 ? std::get_if<TrackedSource>(&edge.sources[0]) : nullptr;
   if (!tracked)
     return fail("transform graph: the edge to '" + edge_child_frame +
@@ -119,15 +134,15 @@ UncertainPose TransformGraph::source_value(const EdgeSource& source, std::int64_
   return out;
 }
 
-Result<TransformGraph::EdgeValue> TransformGraph::edge_value(const std::string& child,
-                                                             std::int64_t now_us) const {
-  const Edge& edge = frames_.at(child).edge;
+Result<TransformGraph::EdgeValue> TransformGraph::edge_value(FrameIndex child, std::int64_t now_us) const {
+  const Edge& edge = frames_[child].edge;
   if (!edge.combiner) return EdgeValue{source_value(edge.sources.front(), now_us), std::nullopt};
   std::vector<UncertainPose> candidates;
   for (const auto& s : edge.sources) candidates.push_back(source_value(s, now_us));
   auto combined = edge.combiner->combine(candidates);
-  if (!combined) return fail("transform graph: edge to '" + child + "': " + combined.error().message);
-  return EdgeValue{combined->pose, EdgeChoice{child, combined->chosen, combined->fused}};
+  const std::string& name = frames_[child].name;
+  if (!combined) return fail("transform graph: edge to '" + name + "': " + combined.error().message);
+  return EdgeValue{combined->pose, EdgeChoice{name, combined->chosen, combined->fused}};
 }
 
 Result<UncertainPose> TransformGraph::query(const std::string& A, const std::string& B,
@@ -151,11 +166,11 @@ Result<QueryResult> TransformGraph::query_detailed(const std::string& A, const s
                                                    std::int64_t now_us, Propagation mode) const {
   std::lock_guard lock(mutex_);  // one lock for the whole query: consistent edges
   for (const auto* f : {&A, &B})
-    if (!frames_.contains(*f)) return fail("transform graph: unknown frame '" + *f + "'");
-  const auto up_A = ancestry(A);
-  const auto up_B = ancestry(B);
-  const std::set<std::string> set_A(up_A.begin(), up_A.end());
-  const auto lca = std::find_if(up_B.begin(), up_B.end(), [&](const auto& f) { return set_A.contains(f); });
+    if (!index_.contains(*f)) return fail("transform graph: unknown frame '" + *f + "'");
+  const auto up_A = ancestry(*find(A));
+  const auto up_B = ancestry(*find(B));
+  const std::unordered_set<FrameIndex> set_A(up_A.begin(), up_A.end());
+  const auto lca = std::find_if(up_B.begin(), up_B.end(), [&](FrameIndex f) { return set_A.contains(f); });
   if (lca == up_B.end())
     return fail("transform graph: frames '" + A + "' and '" + B + "' are in different trees");
 
@@ -163,11 +178,11 @@ Result<QueryResult> TransformGraph::query_detailed(const std::string& A, const s
   const bool from_root = mode != Propagation::LowestCommonAncestor;
   const auto stop_A = from_root ? up_A.end() - 1 : std::find(up_A.begin(), up_A.end(), *lca);
   const auto stop_B = from_root ? up_B.end() - 1 : lca;
-  const std::vector<std::string> path_A(up_A.begin(), stop_A);  // child frames, A upwards
-  const std::vector<std::string> path_B(up_B.begin(), stop_B);
+  const std::vector<FrameIndex> path_A(up_A.begin(), stop_A);  // child frames, A upwards
+  const std::vector<FrameIndex> path_B(up_B.begin(), stop_B);
 
   QueryResult out;
-  std::map<std::string, UncertainPose> values;  // each edge evaluated once per query
+  std::unordered_map<FrameIndex, UncertainPose> values;  // each edge evaluated once per query
   for (const auto* path : {&path_A, &path_B})
     for (const auto& child : *path) {
       if (values.contains(child)) continue;
@@ -179,7 +194,7 @@ Result<QueryResult> TransformGraph::query_detailed(const std::string& A, const s
     }
 
   // Root-to-frame chains (top-down) for the seed modes.
-  auto root_chain = [&](const std::vector<std::string>& path) {
+  auto root_chain = [&](const std::vector<FrameIndex>& path) {
     std::vector<ChainFactor> f;
     for (auto it = path.rbegin(); it != path.rend(); ++it)
       f.push_back({values[*it].T, values[*it].covariance, false});

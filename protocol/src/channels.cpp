@@ -30,14 +30,25 @@ std::string status_channel(std::string_view d) { return join(kStatusPrefix, d); 
 std::string raw_channel(std::string_view d) { return join(kRawPrefix, d); }
 std::string image_channel(std::string_view d) { return join(kImagePrefix, d); }
 
-std::optional<StreamId> parse_pose_channel(std::string_view channel) {
-  if (!channel.starts_with(kPosePrefix)) return std::nullopt;
-  channel.remove_prefix(kPosePrefix.size());
+std::optional<StreamId> parse_stream_channel(std::string_view channel, std::string_view prefix) {
+  if (!channel.starts_with(prefix)) return std::nullopt;
+  channel.remove_prefix(prefix.size());
   const auto slash = channel.find('/');
   if (slash == std::string_view::npos) return std::nullopt;
   StreamId id{std::string(channel.substr(0, slash)), std::string(channel.substr(slash + 1))};
   if (!is_valid_name(id.device) || !is_valid_name(id.sensor)) return std::nullopt;
   return id;
+}
+
+std::optional<std::string> parse_device_channel(std::string_view channel, std::string_view prefix) {
+  if (!channel.starts_with(prefix)) return std::nullopt;
+  channel.remove_prefix(prefix.size());
+  if (!is_valid_name(channel)) return std::nullopt;
+  return std::string(channel);
+}
+
+std::optional<StreamId> parse_pose_channel(std::string_view channel) {
+  return parse_stream_channel(channel, kPosePrefix);
 }
 
 }  // namespace covtrack

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "covtrack/protocol/channels.hpp"
+#include "covtrack/protocol/wire_text.hpp"
 
 namespace covtrack::server {
 namespace {
@@ -28,6 +29,9 @@ const TableSpec& daemon_spec() {
            "wait before restarting a failed driver; doubles on each failure", 0.01, 3600},
           {"restart_backoff_max_s", ValueType::Float, "s", "10", "longest wait between restarts",
            0.01, 3600},
+          {"stop_timeout_s", ValueType::Float, "s", "2",
+           "at SIGINT/SIGTERM, longest wait for the device threads; a device still running then "
+           "is named and the daemon exits anyway, with code 3", 0.1, 600},
       }};
   return spec;
 }
@@ -41,6 +45,7 @@ DaemonSettings read_daemon(TableReader& top) {
   d.heartbeat_hz = r.number("heartbeat_hz", d.heartbeat_hz);
   d.restart_backoff_initial_s = r.number("restart_backoff_initial_s", d.restart_backoff_initial_s);
   d.restart_backoff_max_s = r.number("restart_backoff_max_s", d.restart_backoff_max_s);
+  d.stop_timeout_s = r.number("stop_timeout_s", d.stop_timeout_s);
   if (d.restart_backoff_max_s < d.restart_backoff_initial_s)
     r.error("restart_backoff_max_s", "must not be below restart_backoff_initial_s");
   return d;
@@ -85,6 +90,10 @@ void read_devices(TableReader& top, DaemonConfig& out) {
       top.errors().add(top.file(), node.source(), path, "expected a table [devices." + name + "]");
       continue;
     }
+    // Clients reject a pose whose frame name holds a control character (protocol/README.md).
+    if (const auto* frame = (*table)["parent_frame"].as_string(); frame && control_character_at(frame->get()))
+      top.errors().add(top.file(), frame->source(), path + ".parent_frame",
+                       "must hold no control character (clients would reject every pose)");
     const DriverType* type = read_type(*table, path, top.file(), top.errors());
     if (!type) continue;
     TableReader r(*table, path, *type->specs.front(), top.file(), top.errors());

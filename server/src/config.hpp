@@ -13,6 +13,7 @@ struct DaemonSettings {
   double heartbeat_hz = 1.0;
   double restart_backoff_initial_s = 0.5;
   double restart_backoff_max_s = 10.0;
+  double stop_timeout_s = 2.0;  // longest wait for the device threads at a stop
 };
 
 struct DeviceConfig {

@@ -7,6 +7,7 @@
 
 #include "covtrack/devices/interruptible_sleep.hpp"
 #include "covtrack/protocol/clock.hpp"
+#include "covtrack/protocol/wire_text.hpp"
 
 namespace covtrack::server {
 namespace {
@@ -58,10 +59,25 @@ DeviceRunner::~DeviceRunner() {
 }
 
 void DeviceRunner::start() {
-  thread_ = std::jthread([this](std::stop_token stop) { supervise(stop); });
+  thread_ = std::jthread([this](std::stop_token stop) {
+    supervise(stop);
+    std::lock_guard lock(finished_mutex_);
+    finished_ = true;
+    finished_cv_.notify_all();
+  });
 }
 
 void DeviceRunner::request_stop() { thread_.request_stop(); }
+
+bool DeviceRunner::join_until(std::chrono::steady_clock::time_point deadline) {
+  if (!thread_.joinable()) return true;
+  {
+    std::unique_lock lock(finished_mutex_);
+    if (!finished_cv_.wait_until(lock, deadline, [this] { return finished_; })) return false;
+  }
+  thread_.join();
+  return true;
+}
 
 void DeviceRunner::join() {
   if (thread_.joinable()) thread_.join();
@@ -124,8 +140,10 @@ device_status_t DeviceRunner::heartbeat() {
   s.restarts = restarts_;
   {
     std::lock_guard lock(text_mutex_);
-    s.last_error = last_error_;
-    s.detail = detail_;
+    // An error message may quote bytes a device sent; clients reject a heartbeat whose
+    // text is not UTF-8 (protocol/README.md), so they go out escaped.
+    s.last_error = printable(last_error_);
+    s.detail = printable(detail_);
   }
   reports_at_last_heartbeat_ = reports;
   last_heartbeat_ = now;

@@ -3,6 +3,7 @@
 // and restarts it after a growing back-off, while every other device keeps running.
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <mutex>
 #include <string>
@@ -22,11 +23,15 @@ class DeviceRunner {
 
   void start();
   void request_stop();
+  // Waits for the thread until `deadline`; false if it is still running then (its
+  // driver is blocked in a call that ignores the stop request). A true join never blocks.
+  bool join_until(std::chrono::steady_clock::time_point deadline);
   void join();
 
   // The heartbeat: counters since start, rate since the previous call.
   device_status_t heartbeat();
   const std::string& name() const { return device_.name; }
+  const std::string& type() const { return device_.type; }
 
  private:
   class Sink;
@@ -45,6 +50,10 @@ class DeviceRunner {
 
   std::int64_t reports_at_last_heartbeat_ = 0;
   std::chrono::steady_clock::time_point last_heartbeat_ = std::chrono::steady_clock::now();
+
+  std::mutex finished_mutex_;
+  std::condition_variable finished_cv_;
+  bool finished_ = false;  // supervise() has returned: joining cannot block
 
   std::jthread thread_;
 };

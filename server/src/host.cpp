@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include <fmt/format.h>
+
 #include "covtrack/devices/interruptible_sleep.hpp"
 
 namespace covtrack::server {
@@ -11,26 +13,47 @@ Host::Host(const DaemonConfig& config, lcm::LCM& lcm) : settings_(config.daemon)
     runners_.push_back(std::make_unique<DeviceRunner>(device, publisher_, settings_));
 }
 
-Host::~Host() { stop(); }
+Host::~Host() {
+  // Waits without a limit: a caller that got stuck devices from stop() never gets here.
+  heartbeat_thread_.request_stop();
+  for (auto& r : runners_) r->request_stop();
+  for (auto& r : runners_) r->join();
+}
 
 void Host::start() {
   for (auto& r : runners_) r->start();
   heartbeat_thread_ = std::jthread([this](std::stop_token stop) { publish_heartbeats(stop); });
 }
 
-void Host::stop() {
+std::vector<std::string> Host::stop() {
   // Ask everyone first, then wait: the stop takes as long as the slowest, not the sum.
   heartbeat_thread_.request_stop();
   for (auto& r : runners_) r->request_stop();
-  for (auto& r : runners_) r->join();
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(settings_.stop_timeout_s));
+  std::vector<std::string> stuck;
+  for (auto& r : runners_)
+    if (!r->join_until(deadline))
+      stuck.push_back(fmt::format("device '{}' ({}) did not stop within {:.1f} s", r->name(), r->type(),
+                                  settings_.stop_timeout_s));
   if (heartbeat_thread_.joinable()) heartbeat_thread_.join();
+  return stuck;
 }
 
 void Host::publish_heartbeats(std::stop_token stop) {
   using namespace std::chrono;
   const auto period = duration_cast<steady_clock::duration>(duration<double>(1.0 / settings_.heartbeat_hz));
+  const auto period_us = duration_cast<microseconds>(period).count();
   for (auto next = steady_clock::now() + period; sleep_until(stop, next); next += period)
-    for (auto& r : runners_) publisher_.status(r->heartbeat());
+    for (auto& r : runners_) {
+      device_status_t status = r->heartbeat();
+      status.instance_id = identity_.instance_id;
+      status.host = identity_.host;
+      status.pid = identity_.pid;
+      status.heartbeat_period_us = period_us;
+      publisher_.status(status);
+    }
 }
 
 }  // namespace covtrack::server

@@ -1,6 +1,7 @@
 #pragma once
 // Hosts every configured device and publishes their heartbeats.
 #include <memory>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -9,6 +10,7 @@
 #include "config.hpp"
 #include "device_runner.hpp"
 #include "publisher.hpp"
+#include "publisher_identity.hpp"
 
 namespace covtrack::server {
 
@@ -18,13 +20,18 @@ class Host {
   ~Host();
 
   void start();
-  // Stops every device and the heartbeat, and waits for their threads.
-  void stop();
+  // Asks every device and the heartbeat to stop, and waits for each device's thread up
+  // to daemon.stop_timeout_s in all. Returns a line per device whose thread is still
+  // running then ("device 'cam' (fiducial) did not stop within 2.0 s"): its driver is
+  // blocked in a call that ignores the stop request. The Host must then not be
+  // destroyed (it would wait for that thread); the caller ends the process instead.
+  std::vector<std::string> stop();
 
  private:
   void publish_heartbeats(std::stop_token stop);
 
   DaemonSettings settings_;
+  PublisherIdentity identity_ = PublisherIdentity::of_this_process();
   Publisher publisher_;
   std::vector<std::unique_ptr<DeviceRunner>> runners_;
   std::jthread heartbeat_thread_;

@@ -1,6 +1,7 @@
 // covtrackd: hosts tracker drivers and publishes their poses with covariances over LCM.
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -9,26 +10,30 @@
 #include "config.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 #include "host.hpp"
+#include "stop_signals.hpp"
 
 namespace {
-// Exit codes: 0 stopped by a signal, 1 could not start, 2 bad config or usage.
+// Exit codes (also in --help and README.md).
 constexpr int kExitCannotStart = 1;
 constexpr int kExitBadConfig = 2;
+constexpr int kExitDeviceDidNotStop = 3;
+constexpr const char* kExitCodes =
+    "Exit codes: 0 stopped by SIGINT/SIGTERM; 1 could not start (LCM); 2 bad config or usage; "
+    "3 stopped, but a device's thread did not end within daemon.stop_timeout_s (named on the log; "
+    "the daemon exits anyway). A stop signal before the devices start ends covtrackd at once, "
+    "by that signal (status 130 or 143 in a shell).";
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Block the stop signals before any thread exists, so that every thread inherits the
-  // mask and only sigwait() below receives them.
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  // First of all: a config that blocks (a pipe nobody writes) must not make the daemon
+  // deaf to SIGINT/SIGTERM.
+  covtrack::server::end_at_once_on_stop_signal();
 
   CLI::App app{"covtrackd: tracker daemon publishing pose + covariance over LCM", "covtrackd"};
+  app.footer(kExitCodes);
   std::string config_path, lcm_url, log_level = "info";
   bool check_only = false, print_schema = false;
-  app.add_option("--config,-c", config_path, "daemon config (TOML), e.g. config/sim.toml");
+  app.add_option("--config,-c", config_path, "daemon config (TOML; a file or a pipe), e.g. config/sim.toml");
   app.add_option("--lcm-url", lcm_url, "LCM URL (overrides the config's daemon.lcm_url)");
   app.add_flag("--check", check_only, "validate the config, open every file and device it names, and exit");
   app.add_flag("--print-schema", print_schema, "print the config schema (Markdown) and exit");
@@ -67,6 +72,8 @@ int main(int argc, char** argv) {
     return kExitBadConfig;
   }
 
+  // Before LCM or the host start a thread: from here on every thread inherits the mask.
+  const sigset_t stop_signals = covtrack::server::block_stop_signals();
   const std::string url = covtrack::effective_lcm_url(lcm_url.empty() ? config->daemon.lcm_url : lcm_url);
   auto lcm = covtrack::open_lcm(url);
   if (!lcm) {
@@ -78,9 +85,13 @@ int main(int argc, char** argv) {
   host.start();
   spdlog::info("covtrackd: {} device(s) publishing on {}", config->devices.size(), url);
 
-  int signal = 0;
-  sigwait(&stop_signals, &signal);
+  const int signal = covtrack::server::wait_for_stop_signal(stop_signals);
   spdlog::info("covtrackd: {} received, stopping", signal == SIGINT ? "SIGINT" : "SIGTERM");
-  host.stop();
+  if (const auto stuck = host.stop(); !stuck.empty()) {
+    for (const auto& line : stuck) spdlog::error("covtrackd: {}; exiting anyway", line);
+    spdlog::shutdown();  // flushes the log
+    // Without unwinding: the host would wait for the stuck thread in its destructor.
+    std::_Exit(kExitDeviceDidNotStop);
+  }
   return 0;
 }

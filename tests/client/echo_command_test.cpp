@@ -127,6 +127,53 @@ TEST(EchoCommand, PlainTableOncePerSecondWhenNotATerminal) {
   EXPECT_GE(rows, 1);
 }
 
+namespace {
+
+// Poses and heartbeats of device "hb" (period 50 ms) for `seconds`, then silence: a daemon killed.
+void publish_then_die(double seconds) {
+  lcm::LCM lcm(kUrl);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  for (std::int64_t seq = 0; std::chrono::steady_clock::now() < end; ++seq) {
+    const auto m = test::pose_message("hb", "s", seq);
+    lcm.publish(pose_channel("hb", "s"), &m);
+    device_status_t st{};
+    st.device = "hb";
+    st.heartbeat_period_us = 50'000;
+    st.instance_id = 77;
+    lcm.publish(status_channel("hb"), &st);
+    std::this_thread::sleep_for(10ms);
+  }
+}
+
+}  // namespace
+
+TEST(EchoCommand, DeviceWhoseHeartbeatStopsIsUnreachableAndItsStreamLost) {
+  std::jthread daemon([] { publish_then_die(0.5); });
+  const auto json = run(kCovtrack + " echo --json --duration 2 --lcm-url '" + kUrl + "'");
+  ASSERT_FALSE(json.lines.empty());
+  const auto last = nlohmann::json::parse(json.lines.back());
+  EXPECT_EQ(last["status"], "LOST");
+  EXPECT_EQ(last["device_unreachable"], true);
+  EXPECT_EQ(nlohmann::json::parse(json.lines.front())["device_unreachable"], false);
+  daemon.join();
+
+  std::jthread again([] { publish_then_die(0.5); });
+  const auto table = run(kCovtrack + " echo --duration 2.2 --lcm-url '" + kUrl + "'");
+  ASSERT_GE(table.lines.size(), 2u);
+  std::string last_table;  // the lines after the last header
+  for (const auto& l : table.lines) last_table = l.starts_with("stream") ? l : last_table + l;
+  EXPECT_NE(last_table.find("UNREACHABLE: no heartbeat for"), std::string::npos) << last_table;
+  EXPECT_NE(last_table.find("LOST"), std::string::npos) << last_table;
+}
+
+TEST(EchoCommand, SaysSoWhenNothingArrives) {
+  const auto out = run(kCovtrack + " echo --duration 3.5 --lcm-url '" + kUrl + "' 2>&1 >/dev/null");
+  EXPECT_EQ(out.exit_code, 0);
+  std::string all;
+  for (const auto& l : out.lines) all += l;
+  EXPECT_NE(all.find("nothing received for 3 s on " + kUrl), std::string::npos) << all;
+}
+
 TEST(EchoCommand, BadUrlFailsAtOnceWithAMessage) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto out = run(kCovtrack + " echo --lcm-url udpm://10.1.2.3:7667 2>&1");

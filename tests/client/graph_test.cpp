@@ -2,11 +2,13 @@
 // here is sampled, never typed in.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <random>
+#include <string>
 #include <thread>
 
 #include <Eigen/Eigenvalues>
@@ -263,6 +265,44 @@ TEST(TransformGraph, RejectsCyclesSecondParentsAndUnknownFrames) {
   EXPECT_FALSE(g.update("b", TrackedTransform{}));  // a static edge
   EXPECT_FALSE(g.update("nowhere", TrackedTransform{}));
   EXPECT_FALSE(g.add_combined_edge("a", "z", {}, Combiner::smallest()));
+}
+
+// The cycle check keeps track of which frames share a tree as trees are joined: a chain
+// added in a random order (pieces that grow and merge) takes every link, refuses every
+// edge that would close a loop on the way, and gives the same T_f0_fN as the chain added
+// top-down.
+TEST(TransformGraph, ChainAddedInAnyOrderRefusesEveryLoopAndQueriesAlike) {
+  constexpr int kLinks = 300;
+  std::vector<int> order(kLinks);
+  for (int i = 0; i < kLinks; ++i) order[i] = i;
+  std::shuffle(order.begin(), order.end(), std::mt19937(22));
+  const auto name = [](int i) { return "f" + std::to_string(i); };
+  const auto link = [&](int i) { return pose(0.01, 0, 0.002 * (i % 7), 0, 0.01, 0.002 * i); };
+  TransformGraph in_order, shuffled;
+  for (int i = 0; i < kLinks; ++i)
+    ASSERT_TRUE(in_order.add_static_edge(name(i), name(i + 1), link(i), covariance(1e-3, 1e-3, i)));
+  std::vector<bool> added(kLinks, false);  // link i: f_i -> f_i+1
+  int loops_refused = 0;
+  for (int i : order) {
+    ASSERT_TRUE(shuffled.add_static_edge(name(i), name(i + 1), link(i), covariance(1e-3, 1e-3, i))) << i;
+    added[i] = true;
+    // The piece holding link i runs from f_top to f_bottom; an edge from any of its frames
+    // back to f_top closes a loop.
+    int top = i, bottom = i + 1;
+    while (top > 0 && added[top - 1]) --top;
+    while (bottom < kLinks && added[bottom]) ++bottom;
+    auto loop = shuffled.add_static_edge(name(bottom), name(top), Pose::Identity());
+    ASSERT_FALSE(loop) << "f" << bottom << " -> f" << top << " closes a loop";
+    EXPECT_NE(loop.error().message.find("cycle"), std::string::npos) << loop.error().message;
+    ++loops_refused;
+  }
+  EXPECT_EQ(loops_refused, kLinks);
+  const auto a = in_order.query("f0", name(kLinks), kT0);
+  const auto b = shuffled.query("f0", name(kLinks), kT0);
+  ASSERT_TRUE(a && b);
+  EXPECT_TRUE(a->T.isApprox(b->T, 1e-12));
+  EXPECT_TRUE(a->covariance.isApprox(b->covariance, 1e-12));
+  EXPECT_GT(a->covariance.trace(), 0);
 }
 
 TEST(Combiner, GraphEdgeSwitchesWhenAPathGoesLost) {

@@ -5,10 +5,12 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <thread>
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "covtrack/client/sequence_tracker.hpp"
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/covariance_conventions.hpp"
@@ -95,7 +97,8 @@ TEST_F(SubscriberTest, CallbackPatternsSelectStreams) {
   ASSERT_TRUE(sub_->on_pose("a/.*", [&](const client::TrackedTransform&) { ++a_calls; }));
   ASSERT_TRUE(sub_->on_pose(".*", [&](const client::TrackedTransform&) { ++all_calls; }));
   EXPECT_FALSE(sub_->on_pose("(", [](const client::TrackedTransform&) {}));
-  for (const char* d : {"a", "b", "ab", "a"}) publish(pose_message(d, "s", 0));
+  std::int64_t seq = 0;  // a repeated number would be a duplicate
+  for (const char* d : {"a", "b", "ab", "a"}) publish(pose_message(d, "s", seq++));
   ASSERT_TRUE(eventually([&] { return all_calls == 4; }));
   EXPECT_EQ(a_calls, 2);
 }
@@ -118,13 +121,32 @@ TEST_F(SubscriberTest, SequenceGapsCountAsLostAndRestartsDoNot) {
   for (std::int64_t seq : {0, 1, 2, 6, 7}) publish(pose_message("dev", "s", seq));  // 3, 4, 5 lost
   ASSERT_TRUE(eventually([&] { return received("dev", "s") == 5; }));
   EXPECT_EQ(counters("dev", "s").lost, 3);
-  for (std::int64_t seq : {0, 1, 2}) publish(pose_message("dev", "s", seq));  // the daemon restarted
-  ASSERT_TRUE(eventually([&] { return received("dev", "s") == 8; }));
+  // The daemon restarted: the new sequence is followed once it carries on alone.
+  for (std::int64_t seq : {0, 1, 2}) publish(pose_message("dev", "s", seq));
+  ASSERT_TRUE(eventually([&] { return counters("dev", "s").restarts == 1; }));
+  EXPECT_EQ(received("dev", "s"), 6);  // 2 is delivered; 0 and 1 came before the restart was sure
+  EXPECT_EQ(counters("dev", "s").foreign, client::SequenceTracker::kConfirm - 1);
   EXPECT_EQ(counters("dev", "s").lost, 3);
   publish(pose_message("dev", "s", 4));  // after the restart, gaps count again
-  ASSERT_TRUE(eventually([&] { return received("dev", "s") == 9; }));
+  ASSERT_TRUE(eventually([&] { return received("dev", "s") == 7; }));
   EXPECT_EQ(counters("dev", "s").lost, 4);
   EXPECT_EQ(counters("other", "s").lost, 0);  // per stream
+}
+
+TEST_F(SubscriberTest, ForgedSequenceFarAheadIsForeignAndLossStaysTrue) {
+  // A forged message 6.7e17 ahead once made `lost` jump by as much.
+  for (std::int64_t seq : {0, 1}) publish(pose_message("dev", "s", seq));
+  auto forged = pose_message("dev", "s", 670'000'000'000'000'000);
+  forged.position_m[0] = 99;
+  publish(forged);
+  for (std::int64_t seq : {2, 3}) publish(pose_message("dev", "s", seq));
+  publish(pose_message("dev", "s", std::numeric_limits<std::int64_t>::min()));  // and far behind
+  publish(pose_message("dev", "s", 4));
+  ASSERT_TRUE(eventually([&] { return received("dev", "s") == 5 && counters("dev", "s").foreign == 2; }));
+  EXPECT_EQ(counters("dev", "s").lost, 0);
+  EXPECT_EQ(counters("dev", "s").restarts, 0);
+  EXPECT_EQ(sub_->latest({"dev", "s"})->sequence, 4);
+  EXPECT_NE(sub_->latest({"dev", "s"})->T_parent_child.translation().x(), 99);  // never delivered
 }
 
 TEST_F(SubscriberTest, RejectedMessagesAreNotCountedAsLost) {
@@ -176,7 +198,7 @@ TEST_F(SubscriberTest, InvalidMessagesAreRejectedCountedAndNeverDelivered) {
   EXPECT_EQ(calls, 0);
   EXPECT_EQ(received("dev", "s"), 0);
   EXPECT_FALSE(sub_->latest({"dev", "s"}));
-  EXPECT_NE(sub_->stream({"dev", "s"})->last_rejection.find("malformed"), std::string::npos);
+  EXPECT_NE(sub_->stream({"dev", "s"})->last_rejection.find("truncated"), std::string::npos);
 
   // A valid message is delivered; a later invalid one does not replace it.
   publish(pose_message("dev", "s", 5));
@@ -184,6 +206,40 @@ TEST_F(SubscriberTest, InvalidMessagesAreRejectedCountedAndNeverDelivered) {
   ASSERT_TRUE(eventually([&] { return counters("dev", "s").rejected == 7; }));
   EXPECT_EQ(calls, 1);
   EXPECT_EQ(sub_->latest({"dev", "s"})->sequence, 5);
+}
+
+TEST_F(SubscriberTest, MalformedMessagesAreCountedByReasonAndGoodOnesStillArrive) {
+  // The messages that ended clients: a string length of 0 or less made LCM's decoder throw.
+  std::vector<std::uint8_t> good(static_cast<std::size_t>(pose_message("dev", "s", 0).getEncodedSize()));
+  pose_message("dev", "s", 0).encode(good.data(), 0, static_cast<int>(good.size()));
+  const std::size_t device_length_at = 8 + 24;  // fingerprint, three int64
+  for (std::uint8_t last : {0x00, 0xff}) {  // length 0, then -1
+    auto bad = good;
+    for (int i = 0; i < 4; ++i) bad[device_length_at + i] = i < 3 ? (last ? 0xff : 0x00) : last;
+    lcm_->publish(pose_channel("dev", "s"), bad.data(), static_cast<unsigned>(bad.size()));
+  }
+  auto wrong_type = good;
+  wrong_type[0] ^= 0x01;
+  lcm_->publish(pose_channel("dev", "s"), wrong_type.data(), static_cast<unsigned>(wrong_type.size()));
+  auto not_utf8 = pose_message("dev", "s", 0);
+  not_utf8.parent_frame = "w\xff";  // ended `covtrack echo --json` (nlohmann type_error.316)
+  publish(not_utf8);
+  const std::uint8_t garbage[] = {1, 2, 3};
+  lcm_->publish("covtrack/pose/not a stream", garbage, sizeof garbage);  // counted, yet no stream's
+  lcm_->publish(status_channel("dev"), garbage, sizeof garbage);          // a heartbeat's turn
+  publish(pose_message("dev", "s", 1));
+  ASSERT_TRUE(eventually([&] { return received("dev", "s") == 1 && sub_->rejections().total == 6; }));
+  const RejectionTally tally = sub_->rejections();
+  EXPECT_EQ(tally.by_reason.at("bad length"), 2);
+  EXPECT_EQ(tally.by_reason.at("wrong type"), 1);
+  EXPECT_EQ(tally.by_reason.at("bad channel"), 1);
+  EXPECT_EQ(tally.by_reason.at("truncated"), 1);
+  EXPECT_EQ(tally.by_reason.at("bad text"), 1);
+  EXPECT_NE(tally.last.find("covtrack/status/dev"), std::string::npos) << tally.last;
+  EXPECT_EQ(counters("dev", "s").rejected, 4);
+  EXPECT_EQ(counters("dev", "s").lost, 0);  // the malformed ones told nothing of the sequence
+  EXPECT_EQ(sub_->streams().size(), 1u);
+  EXPECT_TRUE(sub_->device_statuses().empty());
 }
 
 TEST_F(SubscriberTest, EachDefectIsNamedInTheRejection) {
@@ -250,6 +306,7 @@ TEST_F(SubscriberTest, DeviceHeartbeatsAreKeptPerDevice) {
     device_status_t st{};
     st.device = device;
     st.reports = reports;
+    st.heartbeat_period_us = 1'000'000;
     lcm_->publish(status_channel(device), &st);
   }
   ASSERT_TRUE(eventually([&] {
@@ -257,6 +314,37 @@ TEST_F(SubscriberTest, DeviceHeartbeatsAreKeptPerDevice) {
     return s.count("dev") && s.at("dev").reports == 42 && s.count("other");
   }));
   EXPECT_EQ(sub_->device_statuses().size(), 2u);
+}
+
+TEST_F(SubscriberTest, QuietDeviceStaysReachableAndSilentOneIsReportedLost) {
+  open({.stale_after_s = 0.05});
+  std::atomic<int> unreachable_reports{0};
+  ASSERT_TRUE(sub_->on_pose(".*", [&](const client::TrackedTransform& t) { unreachable_reports += t.device_unreachable; }));
+  device_status_t st{};
+  st.device = "dev";
+  st.heartbeat_period_us = 100'000;  // unreachable after 0.3 s without one: far beyond the 10 ms pace below
+  publish(pose_message("dev", "s", 0));
+  // Quiet: heartbeats go on, no pose. The stream goes stale; the device stays reachable.
+  for (int i = 0; i < 30; ++i) {
+    lcm_->publish(status_channel("dev"), &st);
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(eventually([&] { return sub_->stream({"dev", "s"})->stale; }));
+  EXPECT_TRUE(sub_->devices().at("dev").reachable);
+  EXPECT_EQ(unreachable_reports, 0);
+  EXPECT_FALSE(sub_->latest({"dev", "s"})->lost());
+  // Dead: the heartbeats stop too.
+  ASSERT_TRUE(eventually([&] { return unreachable_reports == 1; }));
+  EXPECT_FALSE(sub_->devices().at("dev").reachable);
+  EXPECT_TRUE(sub_->latest({"dev", "s"})->lost());
+  EXPECT_TRUE(sub_->latest({"dev", "s"})->device_unreachable);
+  EXPECT_EQ(sub_->latest({"dev", "s"})->sequence, 0);  // the last message's, not a new one
+  // Back: a heartbeat makes it reachable; the next pose replaces the LOST report.
+  lcm_->publish(status_channel("dev"), &st);
+  publish(pose_message("dev", "s", 1));
+  ASSERT_TRUE(eventually([&] { return received("dev", "s") == 2; }));
+  EXPECT_TRUE(sub_->devices().at("dev").reachable);
+  EXPECT_FALSE(sub_->latest({"dev", "s"})->device_unreachable);
 }
 
 TEST_F(SubscriberTest, StopsPromptlyWhenIdleAndDeliversNothingAfter) {

@@ -1,9 +1,11 @@
 // The fiducial driver's frame sources on real files written by OpenCV: a JPEG or PNG cut
 // short is reported as damaged (named, not decoded half grey) and the files around it
 // still read; a looped sequence starts over within one read; a source that cannot be
-// opened says what it was taken for and where it was looked for.
+// opened says what it was taken for and where it was looked for; a FIFO where a file
+// should be is refused for its kind, never opened (the open would block the driver).
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -175,4 +177,29 @@ TEST(FrameSource, ASourceThatCannotOpenSaysWhatAndWhere) {
             std::string::npos)
       << camera.error().message;
   EXPECT_TRUE(check_frame_source(write_sequence("present", ".png", 1).string()).has_value());
+}
+
+// Nobody writes to these FIFOs: if a source opened one, this test would hang, not fail.
+TEST(FrameSource, AFifoWhereAFileShouldBeIsRefusedWithoutOpeningIt) {
+  const fs::path dir = fresh_dir("fifo");
+  for (const std::string name : {"take.avi", "still.png"}) {
+    const std::string fifo = (dir / name).string();
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    EXPECT_NE(error_of(fifo).find("'" + fifo + "' is a FIFO (named pipe), not a regular file"), std::string::npos)
+        << error_of(fifo);
+  }
+  // A sequence whose second frame became a FIFO: that frame is skipped as damaged, named.
+  const fs::path pattern = write_sequence("fifo_frame", ".png", 3);
+  const fs::path second = pattern.parent_path() / "frame_0001.png";
+  fs::remove(second);
+  ASSERT_EQ(::mkfifo(second.c_str(), 0600), 0);
+  auto seq = open_frame_source(pattern.string(), false);
+  ASSERT_TRUE(seq.has_value()) << seq.error().message;
+  EXPECT_EQ((*seq)->next()->kind, FrameRead::Kind::Frame);
+  const auto fifo_frame = (*seq)->next();
+  ASSERT_TRUE(fifo_frame.has_value());
+  EXPECT_EQ(fifo_frame->kind, FrameRead::Kind::Damaged);
+  EXPECT_EQ(fifo_frame->name, second.string());
+  EXPECT_EQ(fifo_frame->problem, "is a FIFO (named pipe), not a regular file");
+  EXPECT_EQ((*seq)->next()->kind, FrameRead::Kind::Frame);
 }

@@ -1,12 +1,16 @@
 // The lenz driver against the emulator, in one process over a real pseudo-terminal:
 // honesty of the reported uncertainty against the emulator's true train position, the
-// LI-USB framing, and a port that disappears mid-run and comes back.
+// LI-USB framing, a port that disappears mid-run and comes back, and a line of pure
+// noise, which must end the run as a failure (the daemon then resets the device).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <future>
+#include <random>
 #include <set>
 #include <thread>
 
@@ -15,6 +19,7 @@
 #include "capture_sink.hpp"
 #include "covtrack/devices/lenz/layout_config.hpp"
 #include "covtrack/devices/lenz/lenz_driver.hpp"
+#include "covtrack/devices/serial/pseudo_terminal.hpp"
 #include "covtrack/emulators/lenz/lenz_emulator.hpp"
 #include "covtrack/protocol/clock.hpp"
 
@@ -54,9 +59,13 @@ struct Rig {
     config.rate_hz = 50;
     config.keepalive_s = 0.2;
     config.link_timeout_s = 1.0;
+    config.no_valid_frames_s = 1.0;
     config.reconnect_s = 0.1;
     driver = make_lenz_driver(config);
-    driver_thread = std::jthread([this](std::stop_token stop) { result = driver->run(sink, stop); });
+    driver_thread = std::jthread([this](std::stop_token stop) {
+      result = driver->run(sink, stop);
+      returned = true;
+    });
   }
   ~Rig() {
     driver_thread.request_stop();
@@ -77,6 +86,7 @@ struct Rig {
   std::unique_ptr<Driver> driver;
   test::CaptureSink sink;
   Result<void> result;
+  std::atomic<bool> returned{false};  // before a stop: the driver gave up on a valid stream
   std::jthread emulator_thread, driver_thread;
 };
 
@@ -135,6 +145,7 @@ TEST(LenzDriver, UncertaintyContainsTheTruthOverSpeedChangesAndAStop) {
   EXPECT_LT(width_sum / degraded, layout.length_m() / layout.sections().size());
   EXPECT_EQ(vehicles_seen, 3);
   EXPECT_EQ(rig.sink.errors, 0);
+  EXPECT_FALSE(rig.returned) << "a valid stream was failed: " << (rig.result ? "" : rig.result.error().message);
   // The startup queries went out and the replies came back, all on the raw stream.
   const auto raw = rig.raw();
   EXPECT_TRUE(contains(raw, {0xF0, 0xF0}));
@@ -156,6 +167,7 @@ TEST(LenzDriver, LiUsbPrefixesBothWays) {
   EXPECT_TRUE(contains(raw, {0xFF, 0xFE, 0x62, 0x22, 0x00, 0x40}));  // reply
   EXPECT_TRUE(contains(raw, {0xFF, 0xFD}));                          // a feedback broadcast
   EXPECT_EQ(rig.sink.errors, 0);
+  EXPECT_FALSE(rig.returned) << "a valid stream was failed: " << (rig.result ? "" : rig.result.error().message);
 }
 
 TEST(LenzDriver, PortClosedMidRunGoesLostAndResumesOnReopen) {
@@ -205,4 +217,53 @@ TEST(LenzDriver, MissingPortAtStartIsAClearError) {
   const auto result = driver->run(sink, stop.get_token());
   ASSERT_FALSE(result);
   EXPECT_NE(result.error().message.find("/dev/covtrack-no-such-li101f"), std::string::npos) << result.error().message;
+}
+
+// Random bytes keep the line busy (so it never looks silent) without a single status
+// reply: the driver must end its run with "no valid frames for N s" once N seconds have
+// passed, instead of counting errors forever with every vehicle LOST.
+TEST(LenzDriver, LineOfPureNoiseFailsWithNoValidFrames) {
+  auto pty = serial::PseudoTerminal::create(::testing::TempDir() + "/covtrack_lenz_noise_" +
+                                            std::to_string(::getpid()));
+  ASSERT_TRUE(pty) << pty.error().message;
+  LenzConfig config;
+  config.device = "train";
+  config.port = pty->device_path();
+  config.layout = short_layout();
+  config.keepalive_s = 0.2;
+  config.link_timeout_s = 1.0;
+  config.no_valid_frames_s = 1.0;
+  auto driver = make_lenz_driver(config);
+  test::CaptureSink sink;
+  std::promise<Result<void>> ended;
+  auto result = ended.get_future();
+  const auto started = std::chrono::steady_clock::now();
+  std::jthread driver_thread([&](std::stop_token stop) { ended.set_value(driver->run(sink, stop)); });
+
+  // About 20 kB/s, ten times what an LI101F at 19200 baud can send; the driver's requests
+  // are drained so that its writes never block.
+  std::mt19937 rng(22);
+  std::uint8_t noise[200], drained[256];
+  std::uint64_t noise_bytes = 0;
+  while (result.wait_for(10ms) != std::future_status::ready && std::chrono::steady_clock::now() - started < 20s) {
+    while (pty->read_some(drained, 0ms).value_or(0) > 0) {}
+    for (auto& b : noise) b = static_cast<std::uint8_t>(rng());
+    noise_bytes += pty->write(noise).value_or(0);
+  }
+  ASSERT_EQ(result.wait_for(0s), std::future_status::ready) << "the driver never failed on 20 s of noise";
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const auto outcome = result.get();
+  ASSERT_FALSE(outcome) << "the driver stopped on its own without an error";
+  const std::string& message = outcome.error().message;
+  std::printf("%llu noise bytes, %d errors counted, failed after %.2f s: %s\n",
+              static_cast<unsigned long long>(noise_bytes), sink.errors, took_s, message.c_str());
+  EXPECT_NE(message.find("no valid frames for 1.0 s"), std::string::npos) << message;
+  EXPECT_NE(message.find(config.port), std::string::npos) << message;
+  EXPECT_GE(took_s, config.no_valid_frames_s);
+  // Within the limit plus the driver's 20 ms polling, with room for a loaded machine.
+  EXPECT_LT(took_s, config.no_valid_frames_s + 3.0);
+  EXPECT_GT(sink.errors, 10);  // the noise's bad frames were counted on the way
+  std::lock_guard lock(sink.m);
+  ASSERT_FALSE(sink.poses.empty());
+  EXPECT_EQ(sink.poses.back().status, TrackingStatus::Lost) << "vehicles left with a pose while the device fails";
 }

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <thread>
 
@@ -31,7 +32,8 @@ struct Rig {
 };
 
 Rig make_rig(Model model, const std::vector<int>& stations, const std::string& name,
-             double trouble_every_s = 0, double rate_hz = 0) {
+             double trouble_every_s = 0, double rate_hz = 0,
+             const std::function<void(emulate6dof::EmulatorConfig&)>& tweak = {}) {
   emulate6dof::EmulatorConfig ec;
   ec.model = model;
   ec.link_path = link_path(name);
@@ -40,6 +42,7 @@ Rig make_rig(Model model, const std::vector<int>& stations, const std::string& n
   ec.rate_hz = rate_hz;
   ec.trouble_every_s = trouble_every_s;
   ec.seed = 7 + static_cast<std::uint64_t>(model);  // each model its own noise
+  if (tweak) tweak(ec);
   auto e = emulate6dof::Emulator::create(ec);
   EXPECT_TRUE(e) << e.error().message;
   Rig rig{std::move(*e), {}};
@@ -61,7 +64,7 @@ Serial6dofConfig driver_config(Model model, const std::vector<int>& stations, co
   return c;
 }
 
-// Runs the driver until `wanted` non-LOST poses arrived (or 10 s passed).
+// Runs the driver until `wanted` non-LOST poses arrived (or 30 s passed).
 Result<void> run_for_samples(test::CaptureSink& sink, const Serial6dofConfig& c, std::size_t wanted,
                              std::uint64_t run_index = 0) {
   auto driver = make_serial6dof_driver(c, run_index);
@@ -72,7 +75,7 @@ Result<void> run_for_samples(test::CaptureSink& sink, const Serial6dofConfig& c,
     result = driver->run(sink, stop.get_token());
     done = true;
   });
-  for (int i = 0; i < 1000 && !done; ++i) {
+  for (int i = 0; i < 3000 && !done; ++i) {
     {
       std::lock_guard l(sink.m);
       std::size_t good = 0;
@@ -89,6 +92,7 @@ Result<void> run_for_samples(test::CaptureSink& sink, const Serial6dofConfig& c,
 struct NeesSummary {
   double mean = 0;
   int n = 0, degraded = 0;
+  int outside = 0;  // beyond the 99.9 % quantile of chi-square(6)
 };
 
 NeesSummary nees(const test::CaptureSink& sink, const Rig& rig) {
@@ -97,7 +101,9 @@ NeesSummary nees(const test::CaptureSink& sink, const Rig& rig) {
   for (const auto& p : sink.poses) {
     if (p.status == TrackingStatus::Lost) continue;
     const Vec6 e = boxminus(rig.truth.at(p.sensor), p.T_parent_child);  // T_true = T_est Exp(e)
-    sum += e.dot(p.covariance.inverse() * e);
+    const double nees = e.dot(p.covariance.inverse() * e);
+    sum += nees;
+    s.outside += nees > 22.458;
     ++s.n;
     s.degraded += p.status == TrackingStatus::Degraded;
   }
@@ -107,6 +113,7 @@ NeesSummary nees(const test::CaptureSink& sink, const Rig& rig) {
 
 // 99.9 % two-sided bound on the mean of n chi-square(6) values (variance 12 each).
 double nees_bound(int n) { return 3.29 * std::sqrt(12.0 / n); }
+constexpr double kGateShift = 0.15;
 
 class Serial6dofDriverNees : public ::testing::TestWithParam<Model> {};
 
@@ -123,7 +130,10 @@ TEST_P(Serial6dofDriverNees, ReportedCovarianceMatchesTheErrorsAgainstTruth) {
   EXPECT_TRUE(result) << result.error().message;
   const auto s = nees(sink, rig);
   ASSERT_GE(s.n, 1500) << "errors: " << sink.errors;
-  EXPECT_NEAR(s.mean, 6.0, nees_bound(s.n)) << name << " over " << s.n << " poses";
+  // The plausibility gate widens the covariance of the 2.5 % most surprising records,
+  // which lowers a clean stream's mean NEES by about 0.1: the band is shifted by that.
+  EXPECT_GT(s.mean, 6.0 - nees_bound(s.n) - kGateShift) << name << " over " << s.n << " poses";
+  EXPECT_LT(s.mean, 6.0 + nees_bound(s.n)) << name << " over " << s.n << " poses";
   if (model != Model::Flock) {
     EXPECT_GT(s.degraded, 10) << "trouble flags must give DEGRADED";
   }
@@ -136,6 +146,59 @@ TEST_P(Serial6dofDriverNees, ReportedCovarianceMatchesTheErrorsAgainstTruth) {
 INSTANTIATE_TEST_SUITE_P(AllModels, Serial6dofDriverNees,
                          ::testing::Values(Model::Fastrak, Model::Is900, Model::Liberty,
                                            Model::Patriot, Model::Flock),
+                         [](const auto& info) { return std::string(model_spec(info.param).name); });
+
+// A noisy serial line (bits flipped, bytes dropped and doubled in what the unit
+// streams, at the rate of a bad cable: about one record in four touched) must not turn
+// into confident wrong poses: at most 0.1 % of what is published may lie outside its
+// own 99.9 % region, which is what an honest covariance gives on a clean line.
+class Serial6dofLineNoise : public ::testing::TestWithParam<Model> {};
+
+TEST_P(Serial6dofLineNoise, CorruptRecordsNeverBecomeConfidentPoses) {
+  const Model model = GetParam();
+  const std::string name = "noise_" + std::string(model_spec(model).name);
+  const double rate_hz = 240;
+  Rig rig = make_rig(model, {1, 2}, name, 0, rate_hz, [](emulate6dof::EmulatorConfig& c) {
+    c.bit_flips_per_s = 120;
+    c.bytes_dropped_per_s = 10;
+    c.bytes_duplicated_per_s = 10;
+  });
+  test::CaptureSink sink;
+  (void)run_for_samples(sink, driver_config(model, {1, 2}, rig.emulator->device_path(), rate_hz), 6000);
+  const auto s = nees(sink, rig);
+  std::cout << "[ line noise ] " << model_spec(model).name << ": " << rig.emulator->noise_events()
+            << " noise events, " << s.n << " poses published (" << s.degraded << " degraded), "
+            << sink.errors << " records dropped, " << s.outside << " outside 99.9%, mean NEES " << s.mean
+            << "\n";
+  ASSERT_GE(s.n, 5000);
+  EXPECT_GT(rig.emulator->noise_events(), 1000u) << "the line must be noisy for the test to mean anything";
+  EXPECT_GT(sink.errors, 0) << "some records must be dropped";
+  EXPECT_LE(s.outside, 0.001 * s.n);
+}
+
+TEST(Serial6dofDriver, TheGateDropsNothingFromACleanMovingStream) {
+  // Receivers swaying like a hand (0.15 m and 0.4 rad at 0.7-1.2 Hz: up to 1.1 m/s).
+  const double rate_hz = 240;
+  Rig rig = make_rig(Model::Liberty, {1, 2}, "sway", 0, rate_hz, [](emulate6dof::EmulatorConfig& c) {
+    c.sway_m = 0.15;
+    c.sway_rad = 0.4;
+    c.sway_hz = 0.7;
+  });
+  test::CaptureSink sink;
+  (void)run_for_samples(sink, driver_config(Model::Liberty, {1, 2}, rig.emulator->device_path(), rate_hz), 3000);
+  int published = 0, degraded = 0;
+  for (const auto& p : sink.poses) {
+    published += p.status != TrackingStatus::Lost;
+    degraded += p.status == TrackingStatus::Degraded;
+  }
+  std::cout << "[ sway ] " << published << " poses, " << degraded << " degraded, " << sink.errors << " dropped\n";
+  ASSERT_GE(published, 3000);
+  EXPECT_EQ(sink.errors, 0) << "a clean stream loses nothing to the gate";
+  EXPECT_LE(degraded, 0.03 * published) << "motion the prediction did not foresee: widened, rarely DEGRADED";
+}
+
+INSTANTIATE_TEST_SUITE_P(EachProtocol, Serial6dofLineNoise,
+                         ::testing::Values(Model::Fastrak, Model::Liberty, Model::Flock),
                          [](const auto& info) { return std::string(model_spec(info.param).name); });
 
 TEST(Serial6dofDriver, InchesAreConfirmedAndConvertedToo) {

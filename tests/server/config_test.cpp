@@ -111,6 +111,13 @@ sigma_rad = [0.001, 0.001, 0.001]
 )"), "'head/left' is not a valid sensor name");
 }
 
+TEST(Config, ParentFrameWithAControlCharacterIsRefused) {
+  // Clients reject such a pose on the wire; the daemon says so before it starts.
+  expect_has(only_error(std::string(kGoodDevice) + "parent_frame = \"world\\u001b[2J\"\n"),
+             "bad.toml:7:16: devices.opt.parent_frame: must hold no control character");
+  EXPECT_TRUE(parse_config(std::string(kGoodDevice) + "parent_frame = \"Welt \u00e9\"\n", "good.toml"));
+}
+
 TEST(Config, NestedTableKeyPath) {
   const auto msg = only_error(std::string(kGoodDevice) + "[devices.opt.motion]\nkind = \"spiral\"\n");
   expect_has(msg, "bad.toml:8:");
@@ -142,6 +149,17 @@ TEST(Config, DisabledDeviceIsValidatedButNotStarted) {
   auto r = parse_config(std::string(kGoodDevice) + "enabled = false\n", "ok.toml");
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_TRUE(r->devices.empty());
+}
+
+// A device node or a folder is no config: reading one could block or never end (a pipe
+// is read; shutdown_e2e_test).
+TEST(Config, ADeviceOrAFolderIsRefusedAsAConfig) {
+  for (const std::string path : {"/dev/zero", "/tmp"}) {
+    auto r = covtrack::server::load_config(path);
+    ASSERT_FALSE(r) << path;
+    EXPECT_NE(r.error().message.find(path + ": is a "), std::string::npos) << r.error().message;
+    EXPECT_NE(r.error().message.find(", not a file to read"), std::string::npos) << r.error().message;
+  }
 }
 
 TEST(Config, SchemaDocumentIsUpToDate) {

@@ -105,6 +105,13 @@ TEST(DaemonEndToEnd, TenSensorsAt1kHzWithoutGapsAndStopWithinOneSecond) {
   ASSERT_TRUE(c.status.count("rig"));
   EXPECT_EQ(int{c.status["rig"].state}, int{device_status_t::STATE_RUNNING});
   EXPECT_NEAR(c.status["rig"].rate_hz, 10000, 1500);
+  // The heartbeat names its publisher and its period (sim_device's daemon: 1 Hz).
+  char host[256] = {};
+  ASSERT_EQ(gethostname(host, sizeof host - 1), 0);
+  EXPECT_EQ(c.status["rig"].host, host);
+  EXPECT_EQ(c.status["rig"].pid, daemon.pid());
+  EXPECT_NE(c.status["rig"].instance_id, 0);
+  EXPECT_EQ(c.status["rig"].heartbeat_period_us, 1'000'000);
 
   int status = 0;
   const double stop_s = daemon.stop(SIGTERM, status);

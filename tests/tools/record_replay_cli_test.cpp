@@ -226,6 +226,31 @@ TEST_F(CliTest, DamagedLogsReplayUpToTheDamageAndExitWith3) {
       << output;
 }
 
+// Messages that fail the wire checks: a log is evidence, so record keeps their bytes and
+// replay publishes them as they are; both count them by reason.
+TEST_F(CliTest, BadMessagesAreRecordedAndReplayedAsTheyCameAndCounted) {
+  const std::string url = url_for(7707);
+  auto messages = covtrack::testing::make_messages(40);
+  Message zero_length = messages[0];  // a pose whose `device` string has length 0
+  ASSERT_TRUE(zero_length.channel.starts_with("covtrack/pose/"));
+  for (int i = 0; i < 4; ++i) zero_length.bytes[8 + 24 + i] = std::byte{0};
+  Message wrong_type{"covtrack/status/sim", messages[0].bytes};  // a pose is no heartbeat
+  messages.insert(messages.begin() + 10, zero_length);
+  messages.insert(messages.begin() + 20, wrong_type);
+  const fs::path log = dir_ / "with-bad.lcmlog";
+  const std::string summary = record_with_cli(url, messages, log);
+  EXPECT_EQ(covtrack::testing::read_log(log), messages);
+  EXPECT_NE(summary.find("recorded as they came: 2 (bad length 1, wrong type 1)"), std::string::npos) << summary;
+
+  std::vector<Message> got;
+  std::string output;
+  const int code = replay_and_collect(
+      url, {COVTRACK_CLI, "replay", log.string(), "--speed", "0", "--lcm-url", url}, messages.size(), got, output);
+  EXPECT_EQ(code, 0) << output;
+  EXPECT_EQ(got, messages);
+  EXPECT_NE(output.find("published as they are: 2 (bad length 1, wrong type 1)"), std::string::npos) << output;
+}
+
 TEST_F(CliTest, MissingLogIsAClearErrorWithExitCode1) {
   auto [code, out] = covtrack::testing::run(
       {COVTRACK_CLI, "replay", (dir_ / "missing.lcmlog").string(), "--lcm-url", url_for(7706)},

@@ -255,6 +255,42 @@ TEST(ViewCli, LogIsFollowedAtItsOwnTime) {
   std::filesystem::remove(scene);
 }
 
+// One damaged byte inside a pose event (a string length of 0 or -1, a fingerprint) made
+// `covtrack view --log` abort in LCM's decoder: now each is counted and the rest is used.
+TEST(ViewCli, CorruptPoseEventsOfALogAreCountedAndTheRestUsed) {
+  const std::filesystem::path scene = write_thing_scene();
+  const std::string log_path = (kTmp / "covtrack_view_corrupt.lcm").string();
+  {
+    auto log = covtrack::lcmlog::LogWriter::create(log_path, true);
+    ASSERT_TRUE(log) << log.error().message;
+    const std::int64_t t0 = 1'700'000'000'000'000;
+    for (int i = 0; i < 50; ++i) {
+      const std::int64_t t = t0 + i * 20'000;
+      const covtrack::pose_cov_t m = thing_message(i, t, false);
+      std::vector<std::byte> bytes(m.getEncodedSize());
+      m.encode(bytes.data(), 0, int(bytes.size()));
+      const std::size_t device_length_at = 8 + 24;
+      if (i == 10) bytes[device_length_at + 3] = std::byte{0};                               // length 0
+      if (i == 11) std::fill_n(bytes.begin() + device_length_at, 4, std::byte{0xff});        // length -1
+      if (i == 12) bytes[3] ^= std::byte{0x10};                                              // fingerprint
+      ASSERT_TRUE(log->write(t, covtrack::pose_channel("viewtest", "thing"), bytes));
+    }
+  }
+  const std::string png = (kTmp / "covtrack_view_corrupt.png").string();
+  const CliRun r = run("view " + scene.string() + " --log " + log_path + " --duration 0.5 --png " + png);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("rejected pose messages of the log: 3 (bad length 2, wrong type 1)"), std::string::npos)
+      << r.out;
+  const cv::Mat image = cv::imread(png, cv::IMREAD_COLOR);
+  int green = 0;
+  for (int y = 0; y < image.rows; ++y)
+    for (int x = 0; x < image.cols; ++x) green += is_green(image.at<cv::Vec3b>(y, x));
+  EXPECT_GT(green, 300);  // the good reports around them drive the regions
+  std::filesystem::remove(png);
+  std::filesystem::remove(log_path);
+  std::filesystem::remove(scene);
+}
+
 namespace {
 
 // A solid-colour camera frame as the fiducial driver publishes it (smaller than the view,

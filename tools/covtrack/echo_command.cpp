@@ -17,7 +17,10 @@
 #include "commands.hpp"
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/protocol/clock.hpp"
+#include "covtrack/protocol/lcm_url.hpp"
+#include "covtrack/protocol/wire_text.hpp"
 #include "stop_signal.hpp"
+#include "subscriber_summary.hpp"
 
 namespace covtrack::cli {
 namespace {
@@ -47,7 +50,8 @@ nlohmann::json to_json(const client::TrackedTransform& t) {
       {"position_m", {t.T_parent_child.translation().x(), t.T_parent_child.translation().y(),
                       t.T_parent_child.translation().z()}},
       {"orientation_wxyz", {q.w(), q.x(), q.y(), q.z()}},
-      {"covariance_convention", "BODY"}};
+      {"covariance_convention", "BODY"},
+      {"device_unreachable", t.device_unreachable}};
   if (t.lost()) {
     j["covariance"] = nullptr;  // infinite: JSON has no infinity
   } else {
@@ -77,7 +81,27 @@ class RateMeter {
   std::map<std::string, std::pair<std::int64_t, double>> last_;
 };
 
-constexpr const char* kRowFormat = "{:<28} {:>8} {:>26} {:>9} {:>9} {:<8} {:>6} {:>6} {:<5} {:>5}\n";
+// How long echo waits for a first message before it says that nothing arrives.
+constexpr std::chrono::seconds kSilenceHint{3};
+
+constexpr const char* kRowFormat = "{:<28} {:>8} {:>26} {:>9} {:>9} {:<8} {:>6} {:>6} {:>7} {:>7} {:<5} {:>5}\n";
+
+// One device's heartbeat: its counters, who publishes it, and what its heartbeats reveal.
+std::string device_line(const std::string& name, const client::DeviceState& d) {
+  const device_status_t& st = d.status;
+  std::string line = fmt::format("device {:<20} {:>7.1f} Hz reports {:>9} errors {:>4} drops {:>4} restarts {:>3}  "
+                                 "from {}:{}", name, st.rate_hz, st.reports, st.errors, st.drops, st.restarts,
+                                 st.host, st.pid);
+  if (!d.reachable)
+    line += fmt::format("  UNREACHABLE: no heartbeat for {:.1f} s, its streams LOST",
+                        1e-6 * static_cast<double>(now_us() - d.last_heard_us));
+  if (d.publishers > 1)
+    line += fmt::format("  {} PUBLISHERS (another daemon publishes this device)", d.publishers);
+  if (d.restarts > 0) line += fmt::format("  daemon restarted {} time(s)", d.restarts);
+  if (!st.detail.empty()) line += "  (" + printable(st.detail) + ")";
+  if (!st.last_error.empty()) line += "  last error: " + printable(st.last_error);
+  return line + "\n";
+}
 
 double steady_now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -85,7 +109,8 @@ double steady_now_s() {
 
 std::string table(const client::Subscriber& sub, RateMeter& rates) {
   std::string out = fmt::format(fmt::runtime(kRowFormat), "stream", "rate Hz", "position m (x y z)",
-                                "σpos mm", "σrot deg", "status", "lost", "reject", "stale", "times");
+                                "σpos mm", "σrot deg", "status", "lost", "reject", "foreign", "restart", "stale",
+                                "times");
   const double now_s = steady_now_s();
   for (const auto& s : sub.streams()) {
     const double rate = rates.update(s.id.key(), s.counters.received, now_s);
@@ -102,16 +127,16 @@ std::string table(const client::Subscriber& sub, RateMeter& rates) {
       }
     }
     out += fmt::format(fmt::runtime(kRowFormat), s.id.key(), fmt::format("{:.1f}", rate), position, sp,
-                       sr, status, s.counters.lost, s.counters.rejected, s.stale ? "STALE" : "",
-                       s.counters.stale);
+                       sr, status, s.counters.lost, s.counters.rejected, s.counters.foreign, s.counters.restarts,
+                       s.stale ? "STALE" : "", s.counters.stale);
   }
   out += "σ: 1-sigma along the worst direction (sqrt of the largest eigenvalue of the 3x3 "
-         "position / rotation block, BODY frame); stale times: how often it went stale\n";
-  for (const auto& [device, st] : sub.device_statuses())
-    out += fmt::format("device {:<20} {:>7.1f} Hz reports {:>9} errors {:>4} drops {:>4} restarts {:>3}{}{}\n",
-                       device, st.rate_hz, st.reports, st.errors, st.drops, st.restarts,
-                       st.detail.empty() ? "" : "  (" + st.detail + ")",
-                       st.last_error.empty() ? "" : "  last error: " + st.last_error);
+         "position / rotation block, BODY frame); foreign: messages off the stream's sequence "
+         "(a second publisher, forged, duplicate); restart: the sequence started again; stale "
+         "times: how often it went stale\n";
+  if (const RejectionTally rejected = sub.rejections(); rejected.total > 0)
+    out += "rejected messages: " + rejected.summary() + "\n";
+  for (const auto& [name, device] : sub.devices()) out += device_line(name, device);
   return out;
 }
 
@@ -123,13 +148,20 @@ int run_echo(const EchoOptions& o) {
     std::cerr << "covtrack echo: " << sub.error().message << "\n";
     return 1;
   }
+  // Scripts and tests wait for this line: from here on every message is seen.
+  std::cerr << fmt::format("covtrack echo: listening on {} for streams '{}' (Ctrl-C ends)\n",
+                           effective_lcm_url(o.subscriber.lcm_url), o.subscriber.pattern);
   std::atomic<long> seen{0};
   // Runs on the subscriber's dispatch thread, the only writer of stdout in --json mode.
   (void)(*sub)->on_pose(".*", [&](const client::TrackedTransform& t) {
     if (o.count > 0 && seen >= o.count) return;
-    if (o.json) std::cout << to_json(t).dump() << "\n" << std::flush;
+    // The wire checks let only UTF-8 through; `replace` keeps a slip there from ending echo.
+    if (o.json) std::cout << to_json(t).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n" << std::flush;
     ++seen;
   });
+  // With no daemon on this URL echo would wait in silence: say so once, on stderr.
+  const auto hint_at = std::chrono::steady_clock::now() + kSilenceHint;
+  bool hinted = false;
   const bool tty = ::isatty(STDOUT_FILENO);
   const auto start = std::chrono::steady_clock::now();
   auto next_table = start + std::chrono::milliseconds(tty ? 200 : 1000);
@@ -144,12 +176,21 @@ int run_echo(const EchoOptions& o) {
     const auto now = std::chrono::steady_clock::now();
     if (o.count > 0 && seen >= o.count) break;
     if (o.duration_s > 0 && now - start >= std::chrono::duration<double>(o.duration_s)) break;
+    if (!hinted && now >= hint_at) {
+      hinted = true;
+      if ((*sub)->streams().empty() && (*sub)->devices().empty())
+        std::cerr << fmt::format("covtrack echo: nothing received for {} s on {} (streams '{}'): is covtrackd "
+                                 "running and publishing there? (covtrackd --config config/sim.toml)\n",
+                                 kSilenceHint.count(), effective_lcm_url(o.subscriber.lcm_url),
+                                 o.subscriber.pattern);
+    }
     if (!o.json && now >= next_table) {
       next_table += std::chrono::milliseconds(tty ? 200 : 1000);
       print_table();
     }
   }
   (*sub)->stop();
+  std::cerr << subscriber_summary(**sub, "covtrack echo: ");
   return 0;
 }
 

@@ -51,6 +51,9 @@ void print_summary(const lcmlog::RecordSummary& s, const std::string& path) {
              s.duration_s, path);
   for (const auto& [channel, count] : s.events_per_channel)
     fmt::print(stderr, "  {:<63} {}\n", channel, count);
+  if (s.bad_messages.total > 0)
+    fmt::print(stderr, "covtrack record: warning: messages that fail the covtrack wire checks, recorded as they came: {}\n",
+               s.bad_messages.summary());
 }
 
 int run_record(const RecordArgs& args) {

@@ -92,6 +92,9 @@ int run_replay(const ReplayArgs& args) {
   fmt::print(stderr, "covtrack replay: published {} events ({} payload bytes){}\n",
              summary->events_published, summary->payload_bytes,
              summary->stopped ? ", stopped" : "");
+  if (summary->bad_messages.total > 0)
+    fmt::print(stderr, "covtrack replay: warning: messages that fail the covtrack wire checks, published as they are: {}\n",
+               summary->bad_messages.summary());
   if (summary->damage.empty()) return 0;
   for (const auto& damage : summary->damage)
     fmt::print(stderr, "covtrack replay: warning: log '{}' {}\n", args.path,

@@ -24,9 +24,11 @@
 #include "commands.hpp"
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/protocol/clock.hpp"
+#include "covtrack/protocol/lcm_url.hpp"
 #include "region_drawing.hpp"
 #include "regions_report.hpp"
 #include "stop_signal.hpp"
+#include "subscriber_summary.hpp"
 #include "view_background.hpp"
 #include "view_log.hpp"
 #include "view_widgets.hpp"
@@ -128,6 +130,16 @@ int run_view(const ViewArgs& args) {
     latest_report = [&log](const StreamId& id) { return log->latest(id); };
   }
 
+  // What the streams brought, and what was refused, when the view ends.
+  const auto report_rejections = [&] {
+    if (subscriber) {
+      subscriber->stop();
+      std::cerr << subscriber_summary(*subscriber, "covtrack view: ");
+    }
+    if (log && log->rejections().total > 0)
+      std::cerr << "covtrack view: rejected pose messages of the log: " << log->rejections().summary() << "\n";
+  };
+
   const cv::Size size(model->camera.width_px, model->camera.height_px);
   std::string warning;
   ViewBackground background(args.background, size, warning);
@@ -139,6 +151,8 @@ int run_view(const ViewArgs& args) {
   if (window) cv::namedWindow("covtrack view", cv::WINDOW_AUTOSIZE);
 
   install_stop_signals();
+  // Scripts and tests wait for this line: from here on every message counts.
+  if (subscriber) std::cerr << "covtrack view: following the streams on " << effective_lcm_url(args.lcm_url) << "\n";
   const double duration_s = args.duration_s > 0 ? args.duration_s : (video ? 10.0 : 0.0);
   // Offline into a file, nothing outside sets the pace: frames are rendered at their
   // scene times as fast as they can be, and the same command gives the same pictures.
@@ -186,6 +200,7 @@ int run_view(const ViewArgs& args) {
 
     if (!args.png_path.empty()) {
       if (auto r = write_png(image, args.png_path); !r) return fail_with(r.error().message, 1);
+      report_rejections();
       return 0;
     }
     if (video) video->write(image);
@@ -196,6 +211,7 @@ int run_view(const ViewArgs& args) {
     }
     if (last) break;
   }
+  report_rejections();
   return 0;
 }
 

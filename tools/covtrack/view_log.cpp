@@ -3,10 +3,8 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include <covtrack/image_t.hpp>
-#include <covtrack/pose_cov_t.hpp>
-
 #include "covtrack/client/pose_validation.hpp"
+#include "covtrack/protocol/channel_messages.hpp"
 #include "covtrack/protocol/channels.hpp"
 
 namespace covtrack::cli {
@@ -30,19 +28,12 @@ void LogFollower::advance_to(std::int64_t log_time_us, client::TransformGraph& g
 
 void LogFollower::feed(const lcmlog::LogEvent& event, client::TransformGraph& graph) {
   if (event.channel.starts_with(kImagePrefix)) return keep_image(event);
-  const auto stream = parse_pose_channel(event.channel);
-  if (!stream) return;  // raw bytes, truth, heartbeats: not for the view
-  pose_cov_t msg;
-  const int size = static_cast<int>(event.payload.size());
-  if (msg.decode(event.payload.data(), 0, size) != size || client::rejection_reason(msg)) {
-    ++rejected_;
-    return;
-  }
-  client::TrackedTransform t = client::to_tracked_transform(msg, event.timestamp_us);
-  if (t.stream != *stream) {  // a message must name its own channel's stream
-    ++rejected_;
-    return;
-  }
+  if (!event.channel.starts_with(kPosePrefix)) return;  // raw bytes, truth, heartbeats: not for the view
+  const std::string channel(event.channel);
+  const auto msg = decode_pose(channel, event.payload);
+  if (!msg) return rejections_.add(to_string(msg.error().fault), channel, msg.error().describe());
+  if (auto invalid = client::rejection_reason(*msg)) return rejections_.add("invalid pose", channel, *invalid);
+  client::TrackedTransform t = client::to_tracked_transform(*msg, event.timestamp_us);
   latest_[t.stream.key()] = t;
   (void)graph.update(t.stream, t);  // streams the scene does not use are not in the graph
 }
@@ -52,8 +43,7 @@ void LogFollower::keep_image(const lcmlog::LogEvent& event) {
   const std::string_view device = event.channel.substr(kImagePrefix.size());
   if (image_device_.empty()) image_device_ = device;
   if (device != image_device_) return;
-  const auto* bytes = reinterpret_cast<const std::uint8_t*>(event.payload.data());
-  undrawn_.push_back({{bytes, bytes + event.payload.size()}, event.timestamp_us});
+  undrawn_.push_back({{event.payload.begin(), event.payload.end()}, event.timestamp_us});
   if (undrawn_.size() > kKeptImages) undrawn_.pop_front();
 }
 
@@ -61,7 +51,7 @@ const cv::Mat& LogFollower::image(std::string& warning) {
   while (!undrawn_.empty()) {
     const EncodedImage newest = std::move(undrawn_.back());
     undrawn_.pop_back();
-    if (decode_image(newest.payload, newest.time_us, warning)) {
+    if (decode_frame(newest.payload, newest.time_us, warning)) {
       undrawn_.clear();  // older than what is now shown
       break;
     }
@@ -69,16 +59,16 @@ const cv::Mat& LogFollower::image(std::string& warning) {
   return image_;
 }
 
-bool LogFollower::decode_image(const std::vector<std::uint8_t>& payload, std::int64_t time_us,
+bool LogFollower::decode_frame(const std::vector<std::byte>& payload, std::int64_t time_us,
                                std::string& warning) {
   const auto corrupt = [&](const std::string& why) {
     ++corrupt_images_;
     warning = fmt::format("image from '{}' at log time {} us skipped: {}", image_device_, time_us, why);
     return false;
   };
-  image_t msg;
-  const int size = static_cast<int>(payload.size());
-  if (msg.decode(payload.data(), 0, size) != size) return corrupt("not a valid image_t message");
+  const auto message = decode_image(image_channel(image_device_), payload);
+  if (!message) return corrupt(message.error().describe());
+  const image_t& msg = *message;
   if (msg.encoding != "jpeg" && msg.encoding != "png")
     return corrupt(fmt::format("encoding '{}' is neither jpeg nor png", msg.encoding));
   cv::Mat decoded;

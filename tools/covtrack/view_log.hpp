@@ -2,7 +2,8 @@
 // `covtrack view --log FILE`: the view follows a recorded session's time. Pose events up
 // to the current log time are fed to the transform graph, so regions (and staleness)
 // are what a live view showed then. Damaged events are skipped (LogReader resyncs);
-// invalid pose messages are counted, never used. Camera frames (image_t) up to the same
+// pose messages that fail the wire checks (decode_pose()) or are invalid are counted by
+// reason, never used. Camera frames (image_t) up to the same
 // time give the picture behind the regions, as a live see-through view showed it.
 #include <cstdint>
 #include <deque>
@@ -16,6 +17,7 @@
 #include "covtrack/client/tracked_transform.hpp"
 #include "covtrack/client/transform_graph.hpp"
 #include "covtrack/lcmlog/log_reader.hpp"
+#include "covtrack/protocol/rejection_tally.hpp"
 #include "covtrack/protocol/result.hpp"
 
 namespace covtrack::cli {
@@ -30,7 +32,7 @@ class LogFollower {
   std::int64_t start_us() const { return start_us_; }
   bool finished() const { return !pending_; }
   std::optional<client::TrackedTransform> latest(const StreamId& id) const;
-  long rejected() const { return rejected_; }
+  const RejectionTally& rejections() const { return rejections_; }
 
   // The latest camera frame at or before the log time that decodes (BGR, its recorded
   // size), or an empty image before the first one. Only the first device seen sending
@@ -44,10 +46,10 @@ class LogFollower {
   explicit LogFollower(lcmlog::LogReader reader) : reader_(std::move(reader)) {}
   void feed(const lcmlog::LogEvent& event, client::TransformGraph& graph);
   void keep_image(const lcmlog::LogEvent& event);
-  bool decode_image(const std::vector<std::uint8_t>& payload, std::int64_t time_us, std::string& warning);
+  bool decode_frame(const std::vector<std::byte>& payload, std::int64_t time_us, std::string& warning);
 
   struct EncodedImage {
-    std::vector<std::uint8_t> payload;  // an image_t message
+    std::vector<std::byte> payload;  // an image_t message
     std::int64_t time_us;               // its event's log time
   };
   // Frames overtaken before any was drawn: enough to step over a few corrupt ones while
@@ -58,7 +60,7 @@ class LogFollower {
   std::optional<lcmlog::LogEvent> pending_;  // the next event, not yet due
   std::int64_t start_us_ = 0;
   std::map<std::string, client::TrackedTransform> latest_;  // by stream key
-  long rejected_ = 0;
+  RejectionTally rejections_;
 
   std::string image_device_;          // the camera followed; empty until one is seen
   std::deque<EncodedImage> undrawn_;  // its frames newer than image_, oldest first

@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "covtrack/devices/file_kind.hpp"
+
 namespace covtrack {
 
 const char* to_string(ValueType type) {
@@ -250,6 +252,12 @@ std::vector<const toml::table*> TableReader::tables(std::string_view key) {
 }
 
 Result<std::string> read_config_text(const std::string& path) {
+  // A pipe is read to its end, so that `--config <(make-config)` works; the daemon ends
+  // on SIGINT/SIGTERM while it waits for one. A folder or a device is refused: reading
+  // one can block or never end.
+  const FileKind kind = file_kind(path);
+  if (kind != FileKind::Regular && kind != FileKind::Fifo && kind != FileKind::Missing)
+    return fail(fmt::format("{}: is {}, not a file to read", path, describe(kind)));
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(path + ": cannot read the file");
   std::ostringstream text;

@@ -1,22 +1,58 @@
 #include "image_sequence.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "covtrack/devices/fiducial/image_file_check.hpp"
+#include "covtrack/devices/file_kind.hpp"
 
 namespace covtrack::fiducial {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The whole file, or why it cannot be read. Checked to be a regular file before it is
+// opened: a FIFO in its place would block the driver (and a stop request) until someone
+// wrote to it, and opening a device can have effects. Opened without blocking and
+// checked again, should the file have been replaced in between.
+Result<std::vector<std::uint8_t>> read_regular_file(const std::string& name) {
+  if (const FileKind kind = file_kind(name); kind != FileKind::Regular && kind != FileKind::Missing)
+    return fail(fmt::format("is {}, not a regular file", describe(kind)));
+  const int fd = ::open(name.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return fail(fmt::format("cannot be read ({})", std::strerror(errno)));
+  std::vector<std::uint8_t> bytes;
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return fail("is no longer a regular file");
+  }
+  bytes.reserve(static_cast<std::size_t>(st.st_size));
+  std::uint8_t chunk[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, chunk, sizeof chunk);
+    if (n > 0) {
+      bytes.insert(bytes.end(), chunk, chunk + n);
+    } else if (n == 0) {
+      break;
+    } else if (errno != EINTR) {
+      const int error = errno;
+      ::close(fd);
+      return fail(fmt::format("cannot be read ({})", std::strerror(error)));
+    }
+  }
+  ::close(fd);
+  return bytes;
+}
 
 // A file name pattern with one printf-style integer field, as OpenCV's sequence reader
 // takes them ("frame_%04d.png"); parsed rather than handed to printf, so that a stray
@@ -86,20 +122,18 @@ class ImageSequence final : public FrameSource {
   static Result<FrameRead> read(const std::string& name) {
     FrameRead r;
     r.name = name;
-    std::ifstream in(name, std::ios::binary);
-    std::vector<std::uint8_t> bytes;
-    if (in) bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    if (!in && !in.eof()) {
+    const auto bytes = read_regular_file(name);
+    if (!bytes) {
       r.kind = FrameRead::Kind::Damaged;
-      r.problem = fmt::format("cannot be read ({})", std::strerror(errno));
+      r.problem = bytes.error().message;
       return r;
     }
-    if (auto damage = image_file_damage(bytes)) {
+    if (auto damage = image_file_damage(*bytes)) {
       r.kind = FrameRead::Kind::Damaged;
       r.problem = *damage;
       return r;
     }
-    r.image = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+    r.image = cv::imdecode(*bytes, cv::IMREAD_UNCHANGED);
     if (r.image.empty()) {
       r.kind = FrameRead::Kind::Damaged;
       r.problem = "not an image OpenCV can decode";
@@ -144,9 +178,8 @@ Result<std::unique_ptr<FrameSource>> open_image_sequence(const std::string& sour
                               pattern->name(0), pattern->name(1)));
     first = 1;
   }
-  if (!std::ifstream(pattern->name(first), std::ios::binary))
-    return fail(fmt::format("{} '{}': '{}' cannot be read ({})", what, source, pattern->name(first),
-                            std::strerror(errno)));
+  if (auto readable = read_regular_file(pattern->name(first)); !readable)
+    return fail(fmt::format("{} '{}': '{}' {}", what, source, pattern->name(first), readable.error().message));
   return std::make_unique<ImageSequence>(source, *pattern, first, loop);
 }
 

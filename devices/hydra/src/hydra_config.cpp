@@ -4,6 +4,7 @@
 
 #include "covtrack/devices/covariance_keys.hpp"
 #include "covtrack/devices/device_keys.hpp"
+#include "covtrack/devices/valid_frame_watchdog.hpp"
 #include "covtrack/devices/hydra/hydra_driver.hpp"
 #include "covtrack/protocol/channels.hpp"
 
@@ -26,6 +27,9 @@ const TableSpec& hydra_device_spec() {
         {"rate_hz", ValueType::Float, "Hz", "250", "expected reports per second", 1, 10000},
         {"watchdog_periods", ValueType::Float, "", "4",
          "controllers are reported LOST after this many periods without a report", 1, 1000},
+        no_valid_frames_key("10", "no motion report that parses for this long, whatever the base sends: "
+                            "the device FAILED and restarted (\"no valid frames for N s\"); the motion-mode "
+                            "switch is repeated every 2 s meanwhile"),
     };
     s.keys.insert(s.keys.end(), own.begin(), own.end());
     for (auto k : covariance_keys()) {
@@ -51,6 +55,7 @@ HydraConfig read_hydra_config(TableReader& r, const std::string& name) {
   }
   c.rate_hz = r.number("rate_hz", c.rate_hz);
   c.watchdog_periods = r.number("watchdog_periods", c.watchdog_periods);
+  c.no_valid_frames_s = r.number(kNoValidFramesKey, c.no_valid_frames_s);
   const bool given = r.has("covariance") || r.has("sigma_m") || r.has("sigma_rad");
   c.covariance = given ? read_covariance(r) : hydra_default_covariance();
   return c;

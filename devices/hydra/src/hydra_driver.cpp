@@ -6,7 +6,9 @@
 #include <fmt/format.h>
 #include <hidapi/hidapi.h>
 
+#include "covtrack/devices/file_kind.hpp"
 #include "covtrack/devices/hydra/hydra_report.hpp"
+#include "covtrack/devices/valid_frame_watchdog.hpp"
 #include "covtrack/protocol/clock.hpp"
 
 namespace covtrack::hydra {
@@ -15,7 +17,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 // VRPN's experience: a base may need the mode switch repeated; give it this long.
 constexpr double kModeSwitchRetry_s = 2.0;
-constexpr double kNoReports_s = 10.0;
 
 std::string find_hydra_path() {
   std::string path;
@@ -36,6 +37,9 @@ class HydraDriver final : public Driver {
     if (path.empty())
       return fail("Razer Hydra: device not found (USB 1532:0300, interface 0): is it plugged in, "
                   "and may this user open /dev/hidraw* (udev rule)?");
+    // hidapi opens whatever it is given, in blocking mode; only a hidraw node (a character
+    // device) can be a Hydra, and a FIFO or a file there is named here instead.
+    if (auto kind = require_character_device(path, "Razer Hydra: hid_path"); !kind) return kind;
     hid_device* dev = hid_open_path(path.c_str());
     if (!dev) return fail(fmt::format("Razer Hydra: cannot open {} (permissions?)", path));
     auto result = stream(dev, sink, stop);
@@ -48,6 +52,9 @@ class HydraDriver final : public Driver {
     const double period_s = 1.0 / config_.rate_hz;
     const auto motion = motion_mode_feature_report();
     auto last_report = Clock::now(), last_switch = Clock::time_point{};
+    // Reports that do not parse are no sign of life: only a parsed one feeds the watchdog.
+    ValidFrameWatchdog watchdog(config_.no_valid_frames_s, last_report);
+    std::uint64_t bad_reports = 0;
     std::array<std::uint8_t, 64> buffer{};
     bool lost = false;
     while (!stop.stop_requested()) {
@@ -57,8 +64,11 @@ class HydraDriver final : public Driver {
         hid_send_feature_report(dev, motion.data(), motion.size());
         last_switch = Clock::now();
       }
-      if (silent_s > kNoReports_s)
-        return fail(fmt::format("Razer Hydra: no motion reports for {} s", kNoReports_s));
+      if (auto expired = watchdog.expired(Clock::now())) {
+        report_lost(sink);
+        return fail(fmt::format("Razer Hydra: {} ({} reports that did not parse; controllers reported LOST)",
+                                *expired, bad_reports));
+      }
       const int n = hid_read_timeout(dev, buffer.data(), buffer.size(), 20);
       if (n < 0) {
         report_lost(sink);
@@ -73,10 +83,12 @@ class HydraDriver final : public Driver {
       }
       auto report = parse_hydra_report({buffer.data(), static_cast<std::size_t>(n)});
       if (!report) {
+        ++bad_reports;
         sink.count_error(report.error().message);
         continue;
       }
       last_report = Clock::now();
+      watchdog.valid_frame(last_report);
       lost = false;
       const std::int64_t t = now_us();
       for (int i = 0; i < 2; ++i) {

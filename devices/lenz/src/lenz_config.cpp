@@ -7,6 +7,7 @@
 #include "covtrack/devices/device_keys.hpp"
 #include "covtrack/devices/lenz/layout_config.hpp"
 #include "covtrack/devices/serial/baud_rate.hpp"
+#include "covtrack/devices/valid_frame_watchdog.hpp"
 
 namespace covtrack::lenz {
 
@@ -28,6 +29,9 @@ const TableSpec& lenz_device_spec() {
          "that keeps the link alive", 0.05, 30},
         {"link_timeout_s", ValueType::Float, "s", "1.5", "no byte from the interface for this long: "
          "link dead, sensors LOST, reconnect", 0.1, 120},
+        no_valid_frames_key("2 x link_timeout_s", "no answer to the status request (sent every keepalive_s) "
+                            "for this long, whatever other bytes arrive: the line is noise, the device FAILED "
+                            "and restarted (\"no valid frames for N s\")"),
         {"reconnect_s", ValueType::Float, "s", "0.25", "wait between attempts to reopen a lost port", 0.01, 60},
         {"crossing_latency_s", ValueType::Float, "s", "0.05", "a section boundary crossing is reported "
          "at most this late (command station, interface, serial, scheduling)", 0, 5},
@@ -58,6 +62,9 @@ LenzConfig read_lenz_config(TableReader& r, const std::string& device_name) {
   c.keepalive_s = r.number("keepalive_s", c.keepalive_s);
   c.link_timeout_s = r.number("link_timeout_s", c.link_timeout_s);
   if (c.link_timeout_s <= c.keepalive_s) r.error("link_timeout_s", "must be longer than keepalive_s");
+  c.no_valid_frames_s = r.number(kNoValidFramesKey, 2 * c.link_timeout_s);
+  if (c.no_valid_frames_s <= c.keepalive_s)
+    r.error(kNoValidFramesKey, "must be longer than keepalive_s (a healthy interface answers once per keepalive)");
   c.reconnect_s = r.number("reconnect_s", c.reconnect_s);
   c.reckoning.crossing_latency_s = r.number("crossing_latency_s", c.reckoning.crossing_latency_s);
   c.pose_model.track_sigma_m = r.number("track_sigma_m", c.pose_model.track_sigma_m);

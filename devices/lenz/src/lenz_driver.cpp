@@ -1,6 +1,7 @@
 #include "covtrack/devices/lenz/lenz_driver.hpp"
 
 #include <chrono>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -10,6 +11,7 @@
 #include "covtrack/devices/lenz/xpressnet_framing.hpp"
 #include "covtrack/devices/lenz/xpressnet_messages.hpp"
 #include "covtrack/devices/serial/serial_port.hpp"
+#include "covtrack/devices/valid_frame_watchdog.hpp"
 #include "covtrack/protocol/clock.hpp"
 
 namespace covtrack::lenz {
@@ -46,7 +48,13 @@ class LenzDriver final : public Driver {
         continue;
       }
       connected_before = true;
-      if (auto ended = session(**port, sink, stop); !ended) sink.count_error(ended.error().message);
+      if (auto ended = session(**port, sink, stop); !ended) {
+        if (device_failed_) {
+          publish(sink, AlongTrack{});  // what the vehicles are while the daemon resets the device
+          return std::unexpected(*device_failed_);
+        }
+        sink.count_error(ended.error().message);
+      }
       // Crossings may be missed while the link is down: start the estimate afresh.
       reckoner_.reset();
       feedback_.reset();
@@ -57,10 +65,18 @@ class LenzDriver final : public Driver {
 
  private:
   // Talks to one open port until stop (success) or until the link fails (the error).
+  // Only a line that keeps delivering bytes without one status reply ends the whole
+  // run (the device has FAILED, the daemon resets it); a silent one is reopened here.
   Result<void> session(serial::SerialPort& port, SampleSink& sink, std::stop_token stop) {
     if (auto sent = send_startup(port, sink); !sent) return sent;
     auto last_rx = Clock::now();
     auto next_keepalive = Clock::now() + seconds(config_.keepalive_s);
+    // A status reply is the sign of life: the interface answers every keepalive with one,
+    // and its three checked bytes (62 22 .. XOR) turn up in noise about once in 16
+    // million bytes, where a frame with a valid XOR byte turns up once in 256.
+    ValidFrameWatchdog watchdog(config_.no_valid_frames_s, Clock::now());
+    std::uint64_t bytes_since_reply = 0;
+    const std::uint64_t bad_frames_at_start = decoder_.counters().bad_checksums;
     std::uint8_t buffer[256];
     while (!stop.stop_requested()) {
       const auto wait = std::clamp(duration_cast<milliseconds>(next_sample_ - Clock::now()), milliseconds(0),
@@ -70,12 +86,23 @@ class LenzDriver final : public Driver {
       const auto now = Clock::now();
       if (*got > 0) {
         last_rx = now;
+        bytes_since_reply += *got;
         sink.raw(ByteDirection::FromDevice, buffer, *got);
-        handle_bytes({buffer, *got}, sink);
+        if (handle_bytes({buffer, *got}, sink)) {
+          watchdog.valid_frame(now);
+          bytes_since_reply = 0;
+        }
       }
       if (now - last_rx > seconds(config_.link_timeout_s))
         return fail(fmt::format("serial port {}: interface silent for {:.1f} s (no reply to the status request)",
                                 config_.port, duration<double>(now - last_rx).count()));
+      if (auto expired = watchdog.expired(now)) {
+        device_failed_ = Error{fmt::format(
+            "serial port {}: {} (no answer to the status request in {} bytes; {} bad frames this "
+            "connection); the interface will be reset",
+            config_.port, *expired, bytes_since_reply, decoder_.counters().bad_checksums - bad_frames_at_start)};
+        return std::unexpected(*device_failed_);
+      }
       if (now >= next_keepalive) {
         if (auto sent = send(port, sink, CommandStationStatusRequest{}); !sent) return sent;
         next_keepalive = now + seconds(config_.keepalive_s);
@@ -108,7 +135,9 @@ class LenzDriver final : public Driver {
     return port.write_all(bytes, milliseconds(80));
   }
 
-  void handle_bytes(std::span<const std::uint8_t> bytes, SampleSink& sink) {
+  // Returns whether a status reply came (the sign of life; see session()).
+  bool handle_bytes(std::span<const std::uint8_t> bytes, SampleSink& sink) {
+    bool status_reply = false;
     const FramingCounters before = decoder_.counters();
     const auto frames = decoder_.push(bytes);
     const FramingCounters& after = decoder_.counters();
@@ -124,10 +153,12 @@ class LenzDriver final : public Driver {
                      [&](const InterfaceNotice& n) {
                        if (n.code != 0x04 && n.code != 0x07) sink.count_error(describe_notice(n.code));
                      },
+                     [&](const CommandStationStatus&) { status_reply = true; },
                      [&](const auto&) {},
                  },
                  interpret_reply(frame));
     }
+    return status_reply;
   }
 
   void publish(SampleSink& sink, const AlongTrack& along) {
@@ -152,6 +183,7 @@ class LenzDriver final : public Driver {
   Clock::duration period_;
   Clock::time_point next_sample_;
   std::vector<Pose> last_;
+  std::optional<Error> device_failed_;  // set by a session that ends the whole run (no valid frames)
 };
 
 }  // namespace

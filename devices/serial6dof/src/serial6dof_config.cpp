@@ -7,6 +7,7 @@
 
 #include "covtrack/devices/covariance_keys.hpp"
 #include "covtrack/devices/device_keys.hpp"
+#include "covtrack/devices/motion_limit_keys.hpp"
 #include "covtrack/devices/serial/baud_rate.hpp"
 #include "covtrack/protocol/channels.hpp"
 
@@ -73,6 +74,7 @@ TableSpec make_device_spec(Protocol p) {
     own.push_back({"position_scale_in", ValueType::Float, "in", "36",
                    "full scale: 36 or 72 (standard transmitter), 144 (extended range); confirmed "
                    "against the unit", 36, 144});
+  for (const auto& k : motion_limit_keys()) own.push_back(k);
   const auto cov = covariance_keys();
   for (auto k : cov) {
     k.default_value = "the model's";  // optional here: the static accuracy of protocols B.4
@@ -199,6 +201,7 @@ Serial6dofConfig read_serial6dof_config(TableReader& r, const std::string& devic
   c.trouble_inflation = r.number("trouble_inflation", c.trouble_inflation);
   c.latency_s = r.number("latency_s", spec.latency_s);
   c.publish_raw = r.boolean("publish_raw", false);
+  c.motion = read_motion_limits(r);
   return c;
 }
 

@@ -23,6 +23,7 @@ constexpr double kStuckAfter_s = 1.0;
 constexpr double kStuckAfterWatchdogs = 10;
 
 struct StationState {
+  MotionGate gate;
   Clock::time_point last_record;
   Clock::time_point last_lost_report;
   bool lost = false;
@@ -46,7 +47,7 @@ class Serial6dofDriver final : public Driver {
  public:
   Serial6dofDriver(const Serial6dofConfig& config, std::uint64_t run_index)
       : config_(config), spec_(model_spec(config.model)), run_index_(run_index),
-        stations_(config.stations.size()) {}
+        stations_(config.stations.size(), StationState{MotionGate(config.motion, config.period_s())}) {}
 
   Result<void> run(SampleSink& sink, std::stop_token stop) override {
     auto port = serial::SerialPort::open({.path = config_.port, .baud = config_.baud});
@@ -106,9 +107,16 @@ class Serial6dofDriver final : public Driver {
     const auto u = record_uncertainty(record, spec_, it->covariance, config_.trouble_inflation);
     PoseSample s{it->name, config_.parent_frame, it->name, time_us};
     s.T_parent_child = pose_from(record.position_m, record.orientation);
-    s.covariance = u.covariance;
-    s.status = u.status;
+    const auto verdict = stations_[i].gate.check(s.T_parent_child, u.covariance, u.status, time_us * 1e-6);
+    if (verdict.kind == GateVerdict::Kind::Reject) {
+      sink.count_error(fmt::format("{}: station {}: record dropped: {}", config_.port, record.station,
+                                   verdict.reason));
+      return;
+    }
     stations_[i].last_record = now;
+    if (verdict.kind == GateVerdict::Kind::Hold) return;  // published once the next agrees
+    s.covariance = verdict.covariance;
+    s.status = verdict.status;
     stations_[i].lost = false;
     stations_[i].last_estimate = s.T_parent_child;
     sink.pose(s);
@@ -140,7 +148,7 @@ class Serial6dofDriver final : public Driver {
     s.T_parent_child = stations_[i].last_estimate;
     s.covariance = Mat6::Identity() * std::numeric_limits<double>::infinity();
     stations_[i].lost = true;
-    stations_[i].last_lost_report = now;
+    stations_[i].last_lost_report = now;  // the gate restarts by itself after a long silence
     sink.pose(s);
   }
 

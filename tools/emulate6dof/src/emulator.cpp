@@ -10,6 +10,8 @@
 #include "covtrack/devices/sim/se3_gaussian.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "emulated_unit.hpp"
+#include "line_noise.hpp"
+#include "sway.hpp"
 
 namespace covtrack::emulate6dof {
 
@@ -36,7 +38,9 @@ std::vector<EmulatedStation> default_stations(const std::vector<int>& numbers) {
 class Emulator::Impl {
  public:
   Impl(const EmulatorConfig& c, serial::PseudoTerminal pty)
-      : config_(c), spec_(model_spec(c.model)), pty_(std::move(pty)), rng_(c.seed) {
+      : config_(c), spec_(model_spec(c.model)), pty_(std::move(pty)), rng_(c.seed),
+        noise_rng_(c.seed ^ 0x6e6f697365ull),
+        noise_{c.bit_flips_per_s, c.bytes_dropped_per_s, c.bytes_duplicated_per_s} {
     if (config_.rate_hz <= 0)
       config_.rate_hz = station_rate_hz(spec_, static_cast<int>(config_.stations.size()));
     if (config_.reset_time_s < 0) config_.reset_time_s = spec_.reset_time_s;
@@ -110,27 +114,36 @@ class Emulator::Impl {
 
   void report(Emulator& e, bool trouble, const TruthCallback& on_truth) {
     const std::int64_t time_us = now_us();
+    const double t_s = duration<double>(Clock::now() - started_).count();
     std::vector<TrackerRecord> records;
-    for (const auto& st : config_.stations) {
+    for (std::size_t i = 0; i < config_.stations.size(); ++i) {
+      const auto& st = config_.stations[i];
+      const Pose T_true = st.T_source_receiver * sway(t_s, i, config_.sway_m, config_.sway_rad, config_.sway_hz);
       TrackerRecord truth;
       truth.station = st.number;
-      truth.position_m = st.T_source_receiver.translation();
-      truth.orientation = Eigen::Quaterniond(st.T_source_receiver.linear());
+      truth.position_m = T_true.translation();
+      truth.orientation = Eigen::Quaterniond(T_true.linear());
       truth.status_code = trouble ? unit_->trouble_code() : (spec_.protocol == Protocol::Fastrak ? ' ' : 0);
       truth.trouble = trouble;
       truth.device_time_s = static_cast<double>(time_us % 1000000000) * 1e-6;
       // The noise the driver will claim for this record (same model, same inflation).
       const auto u = record_uncertainty(truth, spec_, std::nullopt, config_.trouble_inflation);
-      const Pose T_est = st.T_source_receiver * se3_exp(-sim::Se3Gaussian(u.covariance).draw(rng_));
+      const Pose T_est = T_true * se3_exp(-sim::Se3Gaussian(u.covariance).draw(rng_));
       TrackerRecord r = truth;
       r.position_m = T_est.translation();
       r.orientation = Eigen::Quaterniond(T_est.linear());
       if (r.orientation.w() < 0) r.orientation.coeffs() = -r.orientation.coeffs();
       records.push_back(r);
       if (on_truth)
-        on_truth({st.name, config_.parent_frame, st.name, time_us, st.T_source_receiver});
+        on_truth({st.name, config_.parent_frame, st.name, time_us, T_true});
     }
-    const Bytes bytes = unit_->encode(records);
+    Bytes bytes = unit_->encode(records);
+    if (noise_.any()) {
+      // The first record after configuration gets one period's worth, not the whole reset's.
+      const double elapsed_s = std::min(t_s - last_sent_s_, 2.0 / config_.rate_hz);
+      e.noise_events_ += apply_line_noise(bytes, elapsed_s, noise_, noise_rng_);
+      last_sent_s_ = t_s;
+    }
     if (!bytes.empty() && pty_.write(bytes)) e.records_sent_ += records.size();
   }
 
@@ -139,6 +152,10 @@ class Emulator::Impl {
   serial::PseudoTerminal pty_;
   std::unique_ptr<EmulatedUnit> unit_;
   std::mt19937_64 rng_;
+  std::mt19937_64 noise_rng_;  // apart from rng_: the same seed gives the same pose noise
+  LineNoiseRates noise_;
+  Clock::time_point started_ = Clock::now();
+  double last_sent_s_ = 0;
 };
 
 Result<std::unique_ptr<Emulator>> Emulator::create(const EmulatorConfig& config) {

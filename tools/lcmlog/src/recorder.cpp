@@ -8,6 +8,7 @@
 
 #include "covtrack/lcmlog/channel_filter.hpp"
 #include "covtrack/lcmlog/log_reader.hpp"
+#include "covtrack/protocol/channel_messages.hpp"
 
 namespace covtrack::lcmlog {
 namespace {
@@ -43,6 +44,8 @@ void Recorder::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& cha
   ++summary_.events;
   summary_.bytes += kEventHeaderBytes + channel.size() + rbuf->data_size;
   ++summary_.events_per_channel[channel];
+  if (const auto bad = check_channel_message(channel, payload))
+    summary_.bad_messages.add(to_string(bad->fault), channel, bad->describe());
 }
 
 Result<RecordSummary> Recorder::run(int stop_fd, std::optional<double> duration_s) {

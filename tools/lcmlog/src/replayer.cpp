@@ -4,6 +4,7 @@
 #include <thread>
 
 #include "covtrack/lcmlog/channel_filter.hpp"
+#include "covtrack/protocol/channel_messages.hpp"
 
 namespace covtrack::lcmlog {
 namespace {
@@ -63,6 +64,9 @@ Result<ReplaySummary> replay(LogReader& reader, lcm::LCM& lcm, const ReplayOptio
       }
 
       channel.assign(event->channel);
+      if (summary.passes == 0)
+        if (const auto bad = check_channel_message(channel, event->payload))
+          summary.bad_messages.add(to_string(bad->fault), channel, bad->describe());
       if (lcm_publish(raw_lcm, channel.c_str(), event->payload.data(),
                       static_cast<unsigned int>(event->payload.size())) != 0)
         return fail("publishing '" + channel + "' failed (event at byte offset " +

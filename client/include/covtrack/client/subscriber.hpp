@@ -13,10 +13,18 @@
 // nor destroy the Subscriber.
 //
 // What is delivered: a message is rejected (counted, never passed to latest() or a
-// callback) when it cannot be decoded, names another device/sensor than its channel,
-// has an unknown status or convention, a non-finite position, a non-unit quaternion or
-// a covariance that is non-finite, asymmetric or not positive semi-definite. LOST
-// messages skip the covariance checks: see TrackedTransform.
+// callback) when it fails the wire checks (decode_pose(): type, lengths, names; a
+// malformed message cannot end the process), names another device/sensor than its
+// channel, has an unknown status or convention, a non-finite position, a non-unit
+// quaternion or a covariance that is non-finite, asymmetric or not positive
+// semi-definite. LOST messages skip the covariance checks: see TrackedTransform.
+// Heartbeats are checked the same way (decode_status()). Every rejection is counted by
+// its reason in rejections(); those of a stream's channel also in its counters.
+//
+// Silence: a stream without a message for stale_after_s is stale (it keeps its last
+// value). A device whose heartbeats were heard and then stop for 3 of their periods is
+// unreachable (devices()): each of its streams is reported LOST at once, through latest()
+// and the callbacks, with device_unreachable set, until its next message.
 #include <functional>
 #include <map>
 #include <memory>
@@ -27,7 +35,9 @@
 #include <covtrack/device_status_t.hpp>
 #include <lcm/lcm-cpp.hpp>
 
+#include "covtrack/client/device_tracker.hpp"
 #include "covtrack/client/tracked_transform.hpp"
+#include "covtrack/protocol/rejection_tally.hpp"
 #include "covtrack/protocol/result.hpp"
 
 namespace covtrack::client {
@@ -39,12 +49,20 @@ struct SubscriberOptions {
   // LCM drops the newest message silently when a subscription's queue is full (default
   // 30); this is that queue's length, large enough for a burst of several seconds.
   int queue_capacity = 100000;
+  // The largest forward jump of a stream's sequence still counted as loss; beyond it, or
+  // backwards, a message is off the stream's track (SequenceTracker).
+  std::int64_t sequence_window = 1000;
 };
 
+// Every message on a stream's channel is received, rejected or foreign, exactly one.
 struct StreamCounters {
-  std::int64_t received = 0;  // accepted messages
-  std::int64_t lost = 0;      // sequence numbers skipped (a sequence going back = restart, not loss)
+  std::int64_t received = 0;  // accepted and delivered
+  std::int64_t lost = 0;      // sequence numbers skipped by a forward jump within sequence_window
   std::int64_t rejected = 0;  // malformed or invalid messages (never delivered)
+  // Valid messages off the stream's sequence (a duplicate, a second publisher's, a forged
+  // one; and the SequenceTracker::kConfirm - 1 before a restart is followed): never delivered.
+  std::int64_t foreign = 0;
+  std::int64_t restarts = 0;  // times the stream's sequence started again (a daemon restart)
   std::int64_t stale = 0;     // times the stream went stale
 };
 
@@ -84,9 +102,14 @@ class Subscriber {
   std::vector<StreamState> streams() const;  // ordered by device/sensor
   // The last heartbeat (covtrack/status/<device>) of each device, by device name.
   std::map<std::string, device_status_t> device_statuses() const;
+  // Each device as its heartbeats tell it (reachable, publishers, restarts), by name.
+  std::map<std::string, DeviceState> devices() const;
+  // Every message rejected so far (poses, heartbeats, channels that name no stream).
+  RejectionTally rejections() const;
 
-  // Ends the dispatch thread; idempotent, prompt even when no message arrives. After it
-  // no callback runs; latest() and the counters keep their last values.
+  // Ends the dispatch thread, after it has handled what LCM had already received (for at
+  // most 0.2 s); idempotent, prompt when no message arrives. After it no callback runs;
+  // latest() and the counters keep their last values.
   void stop();
 
  private:

@@ -27,6 +27,9 @@ struct TrackedTransform {
   std::int64_t publish_time_us = 0;      // when the daemon published
   std::int64_t receive_time_us = 0;      // when this client decoded it
   std::int64_t sequence = 0;             // per stream, +1 per message, 0 after a daemon restart
+  // Not from the wire: the client reports the stream LOST (with its last pose, time and
+  // sequence) because its device's heartbeat stopped (DeviceTracker): the daemon is gone.
+  bool device_unreachable = false;
 
   bool lost() const { return status == TrackingStatus::Lost; }
   // Seconds since the device measured the pose (now_us from covtrack::now_us()).

@@ -34,5 +34,9 @@ struct StreamId {
 
 // The stream of a pose channel, or nothing if the channel is not a pose channel.
 std::optional<StreamId> parse_pose_channel(std::string_view channel);
+// The stream of a channel `prefix<device>/<sensor>` (pose, truth), or nothing.
+std::optional<StreamId> parse_stream_channel(std::string_view channel, std::string_view prefix);
+// The device of a channel `prefix<device>` (status, raw, image), or nothing.
+std::optional<std::string> parse_device_channel(std::string_view channel, std::string_view prefix);
 
 }  // namespace covtrack

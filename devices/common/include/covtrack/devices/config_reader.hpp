@@ -112,7 +112,7 @@ class TableReader {
   ConfigErrors& errors_;
 };
 
-// The whole text of a config file, or an error naming it.
+// The whole text of a config file (a regular file or a pipe), or an error naming it.
 Result<std::string> read_config_text(const std::string& path);
 // Parsed TOML, or one error "source:line:column: TOML syntax error: ...".
 Result<toml::table> parse_toml(std::string_view text, const std::string& source_name);

@@ -69,7 +69,10 @@ class Driver {
   virtual ~Driver() = default;
   // Runs until stop is requested (returns success) or the device fails (returns the
   // error; the daemon restarts the driver after a back-off). Must notice a stop
-  // request within 100 ms and must not throw.
+  // request within 100 ms and must not throw. So no call may block for long: a path is
+  // checked for its kind before it is opened (file_kind.hpp; a FIFO blocks an open), and
+  // a device read waits with a timeout. A driver that does not return anyway is named at
+  // the daemon's stop, after daemon.stop_timeout_s, and the daemon exits without it.
   virtual Result<void> run(SampleSink& sink, std::stop_token stop) = 0;
 };
 

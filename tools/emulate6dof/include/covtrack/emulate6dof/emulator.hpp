@@ -33,6 +33,16 @@ struct EmulatorConfig {
   double trouble_every_s = 0;   // flag one record set this often (0: never); noise inflated
   double trouble_inflation = 10;  // must match the driver's to keep the covariance honest
   int flock_scale_code = 0;     // answer to examine position scaling: 0 = 36 in, 1 = 72 in
+  // Motion: each receiver sways about its pose, every axis a sine of its own frequency
+  // (sway_hz to 1.7 x sway_hz); 0 amplitudes: static receivers.
+  double sway_m = 0;
+  double sway_rad = 0;
+  double sway_hz = 0.5;
+  // Line noise on the streamed records (replies during configuration stay clean):
+  // events per second, at random bytes.
+  double bit_flips_per_s = 0;
+  double bytes_dropped_per_s = 0;
+  double bytes_duplicated_per_s = 0;
 };
 
 // Receivers spread in front of the source, each at its own attitude: a default layout.
@@ -59,6 +69,8 @@ class Emulator {
   bool hung() const { return hung_; }
 
   std::uint64_t records_sent() const { return records_sent_; }
+  // Line-noise events applied so far (flips, drops and duplications).
+  std::uint64_t noise_events() const { return noise_events_; }
   std::uint64_t resets() const { return resets_; }
   bool resetting() const { return resetting_; }
 
@@ -70,7 +82,7 @@ class Emulator {
   std::string device_path_;
   std::jthread thread_;
   std::atomic<bool> want_plugged_{true}, plugged_{true}, resetting_{false}, hung_{false};
-  std::atomic<std::uint64_t> records_sent_{0}, resets_{0};
+  std::atomic<std::uint64_t> records_sent_{0}, resets_{0}, noise_events_{0};
 };
 
 }  // namespace covtrack::emulate6dof

@@ -11,6 +11,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "covtrack/lcmlog/log_writer.hpp"
+#include "covtrack/protocol/rejection_tally.hpp"
 #include "covtrack/protocol/result.hpp"
 
 namespace covtrack::lcmlog {
@@ -20,6 +21,9 @@ struct RecordSummary {
   std::uint64_t bytes = 0;  // written to the file, event headers included
   std::map<std::string, std::uint64_t> events_per_channel;
   double duration_s = 0;
+  // Messages of covtrack channels that fail the wire checks (check_channel_message()):
+  // recorded as they came, since a log is evidence, and counted here by reason.
+  RejectionTally bad_messages;
 };
 
 // LCM's default per-subscription queue of 30 drops the newest message silently when

@@ -9,6 +9,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "covtrack/lcmlog/log_reader.hpp"
+#include "covtrack/protocol/rejection_tally.hpp"
 #include "covtrack/protocol/result.hpp"
 
 namespace covtrack::lcmlog {
@@ -31,6 +32,10 @@ struct ReplaySummary {
   std::uint64_t payload_bytes = 0;
   std::uint64_t passes = 0;             // completed passes
   std::vector<LogDamage> damage;        // found in the first pass
+  // Messages of covtrack channels in the first pass that fail the wire checks
+  // (check_channel_message()): published as they are, since a replay reproduces what
+  // was on the wire, and counted here by reason.
+  RejectionTally bad_messages;
   bool stopped = false;                 // `stop` was set before the end
 };
 

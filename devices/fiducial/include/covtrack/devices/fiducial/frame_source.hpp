@@ -37,7 +37,11 @@ bool is_camera_index(const std::string& source);
 // Opens `source`: a camera index; a pattern holding one %d (%04d ...) or a file with an
 // image extension (.png .jpg .jpeg .bmp .pgm .ppm .tif .tiff .webp): image files; any
 // other path: a video file. Errors say what the source was taken for and where it was
-// looked for ("image sequence 'd/f_%04d.png': folder 'd' does not exist").
+// looked for ("image sequence 'd/f_%04d.png': folder 'd' does not exist"). Nothing is
+// opened that could block: image and video files must be regular files and a camera's
+// node a character device, checked first. Cameras are read through OpenCV's V4L2
+// backend and videos through its FFmpeg one, never its automatic choice (which leaks
+// on every failed open).
 Result<std::unique_ptr<FrameSource>> open_frame_source(const std::string& source, bool loop);
 
 // What `covtrackd --check` asks of a source: that it opens. A camera is only opened as

@@ -20,6 +20,8 @@ struct HydraConfig {
   Mat6 covariance = Mat6::Zero();
   double rate_hz = 250;
   double watchdog_periods = 4;
+  // No report that parses for this long, whatever the base sends: FAILED, restarted.
+  double no_valid_frames_s = 10;
 };
 
 // The default covariance: Sixense/Razer state 1 mm position and 1 degree orientation.

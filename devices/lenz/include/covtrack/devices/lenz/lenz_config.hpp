@@ -25,6 +25,9 @@ struct LenzConfig {
   double rate_hz = 20;
   double keepalive_s = 0.5;
   double link_timeout_s = 1.5;
+  // No status reply for this long while bytes arrive: the line is noise, the device has
+  // failed (the daemon restarts it). Default: twice link_timeout_s.
+  double no_valid_frames_s = 3.0;
   double reconnect_s = 0.25;
   DeadReckoningParams reckoning;
   PoseModelParams pose_model;

@@ -5,8 +5,11 @@
 // At (re)connection it asks for the interface version, the command-station version and
 // status, and the state of every feedback module the layout uses; a status request every
 // keepalive_s keeps the link alive. When the port goes away or falls silent the vehicles
-// are reported LOST and the port is reopened until it comes back. Only a port that
-// cannot be opened at the very start is returned as an error (the daemon then retries).
+// are reported LOST and the port is reopened until it comes back. Two cases return an
+// error, so that the daemon marks the device FAILED and restarts it: a port that cannot
+// be opened at the very start, and a line that delivers bytes but no answer to the
+// status request for no_valid_frames_s ("no valid frames for N s": noise, a wrong baud
+// rate, another device on the port).
 #include <memory>
 
 #include "covtrack/devices/driver.hpp"

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "covtrack/devices/config_reader.hpp"
+#include "covtrack/devices/motion_gate.hpp"
 #include "covtrack/devices/serial6dof/device_model.hpp"
 #include "covtrack/devices/serial6dof/fastrak_decoder.hpp"
 #include "covtrack/devices/serial6dof/liberty_decoder.hpp"
@@ -37,6 +38,7 @@ struct Serial6dofConfig {
   double trouble_inflation = 10;                // variance factor when the unit flags trouble
   double latency_s = 0;
   bool publish_raw = false;
+  MotionLimits motion;                          // the plausibility gate
 
   double period_s() const { return 1.0 / rate_hz; }
   double watchdog_s() const { return watchdog_periods * period_s(); }
