@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <map>
 #include <set>
 #include <thread>
 
@@ -38,11 +39,13 @@ class Sink : public SampleSink {
   void count_error(const std::string&) override { ++errors; }
   void count_resync() override {}
   void count_drop() override {}
+  void running(const std::string& detail) override { std::lock_guard l(m); details.push_back(detail); }
   std::size_t raw_count() { std::lock_guard l(m); return raws.size(); }
   std::mutex m;
   std::vector<PoseSample> poses;
   std::vector<std::vector<std::uint8_t>> raws;
   std::vector<ImageSample> images;
+  std::vector<std::string> details;  // the running() detail of each frame
   int errors = 0;
 };
 
@@ -67,15 +70,68 @@ Scene render_sequence(const std::string& name, int frames) {
   return s;
 }
 
-FiducialConfig config_for(const Scene& s) {
+// The frames and camera in `dir`, played once as fast as they are read.
+FiducialConfig sequence_config(const fs::path& dir) {
   FiducialConfig c;
   c.device = "cam";
-  c.source = (s.dir / "frame_%04d.png").string();
-  c.calibration = (s.dir / "camera.yml").string();
+  c.source = (dir / "frame_%04d.png").string();
+  c.calibration = (dir / "camera.yml").string();
   c.detector.decimate = 1;
   c.rate_hz = 0;
   c.loop = false;
+  return c;
+}
+
+FiducialConfig config_for(const Scene& s) {
+  FiducialConfig c = sequence_config(s.dir);
   c.tag_size_m = {{2, 0.1}, {9, 0.1}};
+  return c;
+}
+
+// Four 0.06 m tags (ids 0-3) on a board, 0.11 m apart, as a bundle's config lists them.
+TagBundle board_bundle() {
+  TagBundle b{"board", {}, false};
+  for (int id = 0; id < 4; ++id) {
+    Pose T = Pose::Identity();
+    T.translation() = Vec3((id % 2 - 0.5) * 0.11, (id / 2 - 0.5) * 0.11, 0);
+    b.tags.push_back({id, 0.06, T});
+  }
+  return b;
+}
+
+struct BundleScene {
+  fs::path dir;
+  Pose T_camera_board;
+};
+
+// Frames of the board (its tag `moved`, if any, 2 cm off its place) and tag 9 beside it;
+// the last `without_board` frames show tag 9 alone.
+BundleScene render_bundle_sequence(const std::string& name, int frames, int without_board, int moved = -1) {
+  BundleScene s{fs::path(::testing::TempDir()) / fmt::format("fiducial_bundle_{}_{}", name, getpid()),
+                test::tag_pose(0.55, 20, 10, 15)};
+  fs::create_directories(s.dir);
+  const CameraModel cam = test::camera(640, 480, 60);
+  EXPECT_TRUE(save_camera_model(cam, s.dir / "camera.yml").has_value());
+  auto family = TagFamily::open("tag36h11");
+  const RenderedTag tag9{9, 0.08, test::tag_pose(0.7, -15, 0, 0, 0.2, 0.1)};
+  std::vector<RenderedTag> with_board{tag9};
+  for (BundleTag t : board_bundle().tags) {
+    if (t.id == moved) t.T_bundle_tag.translation().y() += 0.02;
+    with_board.push_back({t.id, t.size_m, s.T_camera_board * t.T_bundle_tag});
+  }
+  std::mt19937_64 rng(7);
+  for (int f = 0; f < frames; ++f) {
+    const cv::Mat clean = render_tags(cam, **family, f < frames - without_board ? with_board : std::vector{tag9},
+                                      RenderLook{});
+    cv::imwrite((s.dir / fmt::format("frame_{:04d}.png", f)).string(), add_sensor_noise(clean, 3, rng));
+  }
+  return s;
+}
+
+FiducialConfig bundle_config_for(const BundleScene& s) {
+  FiducialConfig c = sequence_config(s.dir);
+  c.tag_size_m = {{9, 0.08}};
+  c.bundles = {board_bundle()};
   return c;
 }
 
@@ -247,4 +303,156 @@ TEST(FiducialDriver, ImageOptionErrorsNameTheKey) {
   EXPECT_TRUE(d.publish_images);
   EXPECT_EQ(d.image_every_n, 5);
   EXPECT_EQ(d.image_jpeg_quality, 60);
+}
+
+// A bundle is one sensor: its tags are not published unless asked, it is LOST when none
+// of them is in view, and its pose is near the truth with a covariance that holds it.
+TEST(FiducialDriver, ABundleIsOneSensorItsTagsOnlyWhenAsked) {
+  const BundleScene s = render_bundle_sequence("one", 3, 1);
+  Sink sink;
+  auto r = run_driver(bundle_config_for(s), sink, 3);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  std::map<std::string, std::vector<PoseSample>> by_sensor;
+  for (const PoseSample& p : sink.poses) by_sensor[p.sensor].push_back(p);
+  ASSERT_EQ(by_sensor.size(), 2u) << "only board and tag9, not the board's tags";
+  ASSERT_EQ(by_sensor["board"].size(), 3u);
+  ASSERT_EQ(by_sensor["tag9"].size(), 3u);
+  for (int f = 0; f < 2; ++f) {
+    const PoseSample& p = by_sensor["board"][static_cast<std::size_t>(f)];
+    EXPECT_EQ(p.status, TrackingStatus::Ok);
+    const Vec6 e = boxminus(s.T_camera_board, p.T_parent_child);
+    EXPECT_LT(e.head<3>().norm(), 0.002);
+    EXPECT_LT(e.dot(p.covariance.ldlt().solve(e)), 30.0);
+  }
+  EXPECT_EQ(by_sensor["board"][2].status, TrackingStatus::Lost);
+  EXPECT_EQ(sink.details.front(), "");  // nothing to say while all is well
+
+  FiducialConfig c = bundle_config_for(s);
+  c.bundles[0].publish_tags = true;
+  Sink with_tags;
+  r = run_driver(c, with_tags, 1);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  std::set<std::string> sensors;
+  for (const PoseSample& p : with_tags.poses) sensors.insert(p.sensor);
+  EXPECT_EQ(sensors, (std::set<std::string>{"board", "tag0", "tag1", "tag2", "tag3", "tag9"}));
+}
+
+TEST(FiducialDriver, ABundleWhoseTagIsMovedIsDegradedAndSaysWhy) {
+  const BundleScene s = render_bundle_sequence("moved", 1, 0, 2);
+  Sink sink;
+  auto r = run_driver(bundle_config_for(s), sink, 1);
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  const auto board = std::find_if(sink.poses.begin(), sink.poses.end(), [](const PoseSample& p) { return p.sensor == "board"; });
+  ASSERT_NE(board, sink.poses.end());
+  EXPECT_EQ(board->status, TrackingStatus::Degraded);
+  ASSERT_EQ(sink.details.size(), 1u);
+  EXPECT_EQ(sink.details[0].rfind("board DEGRADED: left out tag 2 is ", 0), 0u) << sink.details[0];
+  const Vec6 e = boxminus(s.T_camera_board, board->T_parent_child);
+  EXPECT_LT(e.dot(board->covariance.ldlt().solve(e)), 16.8) << "the truth inside the 99% region";
+}
+
+TEST(FiducialDriver, BundleConfigIsRead) {
+  ConfigErrors errors;
+  const FiducialConfig c = read_cam_config(R"(bundle_consistency_chi2 = 30
+[[tags]]
+id = 9
+size_m = 0.08
+[[bundles]]
+name = "box"
+publish_tags = true
+[[bundles.tags]]
+id = 1
+size_m = 0.05
+position_m = [0.1, 0, 0]
+rotation_rpy_deg = [0, 0, 90]
+[[bundles.tags]]
+id = 2
+size_m = 0.04
+orientation_wxyz = [0, 1, 0, 0]
+)",
+                                           errors);
+  ASSERT_TRUE(errors.empty()) << errors.joined();
+  EXPECT_EQ(c.bundle_consistency_chi2, 30);
+  ASSERT_EQ(c.bundles.size(), 1u);
+  const TagBundle& b = c.bundles[0];
+  EXPECT_EQ(b.name, "box");
+  EXPECT_TRUE(b.publish_tags);
+  ASSERT_EQ(b.tags.size(), 2u);
+  EXPECT_EQ(b.tags[0].id, 1);
+  EXPECT_EQ(b.tags[0].size_m, 0.05);
+  EXPECT_TRUE(b.tags[0].T_bundle_tag.translation().isApprox(Vec3(0.1, 0, 0)));
+  EXPECT_TRUE(b.tags[0].T_bundle_tag.rotation().isApprox(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()).toRotationMatrix()));
+  EXPECT_TRUE(b.tags[1].T_bundle_tag.rotation().isApprox(Eigen::AngleAxisd(M_PI, Vec3::UnitX()).toRotationMatrix()));
+  EXPECT_EQ(c.tag_size_m.count(1), 0u);  // a bundle's tag is not in the tag map
+
+  ConfigErrors bundles_only;  // a config with bundles needs no tag map
+  read_cam_config("[[bundles]]\nname = \"b\"\n[[bundles.tags]]\nid = 1\nsize_m = 0.05\n", bundles_only);
+  EXPECT_TRUE(bundles_only.empty()) << bundles_only.joined();
+}
+
+TEST(FiducialDriver, BundleConfigErrorsNameTheKey) {
+  ConfigErrors errors;
+  read_cam_config(R"([[tags]]
+id = 9
+size_m = 0.08
+[[bundles]]
+name = "a"
+[[bundles.tags]]
+id = 1
+size_m = 0
+[[bundles.tags]]
+id = 2
+size_m = 0.05
+colour = "red"
+orientation_wxyz = [1, 1, 0, 0]
+[[bundles.tags]]
+id = 3
+size_m = 0.05
+position_m = [0, 0]
+rotation_rpy_deg = [0, 0, 0]
+orientation_wxyz = [1, 0, 0, 0]
+[[bundles]]
+name = "b"
+[[bundles.tags]]
+id = 3
+size_m = 0.05
+[[bundles.tags]]
+id = 9
+size_m = 0.05
+[[bundles.tags]]
+id = 4
+size_m = 0.05
+[[bundles.tags]]
+id = 4
+size_m = 0.05
+[[bundles]]
+name = "tag9"
+tags = []
+[[bundles]]
+name = "no spaces"
+[[bundles.tags]]
+id = 5
+size_m = 0.05
+[[bundles]]
+name = "a"
+[[bundles.tags]]
+id = 6
+size_m = 0.05
+)",
+                  errors);
+  const std::string all = errors.joined();
+  const auto has = [&](const std::string& what) { return all.find(what) != std::string::npos; };
+  EXPECT_TRUE(has("devices.cam.bundles[0].tags[0].size_m: 0 is out of range")) << all;
+  EXPECT_TRUE(has("devices.cam.bundles[0].tags[1].colour: unknown key")) << all;
+  EXPECT_TRUE(has("devices.cam.bundles[0].tags[1].orientation_wxyz: norm is 1.41")) << all;
+  EXPECT_TRUE(has("devices.cam.bundles[0].tags[2].position_m")) << all;
+  EXPECT_TRUE(has("devices.cam.bundles[0].tags[2].orientation_wxyz: give orientation_wxyz or rotation_rpy_deg, not both")) << all;
+  EXPECT_TRUE(has("devices.cam.bundles[4].name: bundle 'a' is named twice")) << all;
+  EXPECT_TRUE(has("devices.cam.bundles[1].tags[0].id: tag 3 is in bundle 'a' already")) << all;
+  EXPECT_TRUE(has("devices.cam.bundles[1].tags[1].id: tag 9 is in the tag map ([[tags]]) too")) << all;
+  EXPECT_TRUE(has("devices.cam.bundles[1].tags[3].id: tag 4 is listed twice in bundle 'b'")) << all;
+  EXPECT_TRUE(has("devices.cam.bundles[2].name: 'tag9' is the sensor name of tag 9")) << all;
+  EXPECT_TRUE(has("devices.cam.bundles[2].tags: a bundle needs at least one tag")) << all;
+  EXPECT_TRUE(has("devices.cam.bundles[3].name: 'no spaces' is not a sensor name")) << all;
+  EXPECT_EQ(errors.list().size(), 12u) << all;
 }

@@ -23,6 +23,19 @@ struct CheckRun {
   std::string output;  // stdout and stderr
 };
 
+// `covtrackd --check` of a config file.
+CheckRun check_file(const std::string& config) {
+  const std::string cmd = std::string(COVTRACK_BINARY_DIR "/server/covtrackd --check --config ") + config + " 2>&1";
+  CheckRun run;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return run;
+  char buf[512];
+  while (fgets(buf, sizeof buf, p)) run.output += buf;
+  const int status = pclose(p);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
 // The config file dir/check.toml with one fiducial device of this source, checked by
 // the daemon binary.
 CheckRun check(const fs::path& dir, const std::string& source, std::string* config_path = nullptr) {
@@ -33,16 +46,7 @@ CheckRun check(const fs::path& dir, const std::string& source, std::string* conf
                            "calibration = \"" COVTRACK_SOURCE_DIR "/config/cameras/rendered_640x480.yml\"\n"
                            "[[devices.eye.tags]]\nid = 0\nsize_m = 0.16\n";
   if (config_path) *config_path = config.string();
-  const std::string cmd = std::string(COVTRACK_BINARY_DIR "/server/covtrackd --check --config ") +
-                          config.string() + " 2>&1";
-  CheckRun run;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return run;
-  char buf[512];
-  while (fgets(buf, sizeof buf, p)) run.output += buf;
-  const int status = pclose(p);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
+  return check_file(config.string());
 }
 
 fs::path fresh_dir(const std::string& name) {
@@ -100,4 +104,11 @@ TEST(FiducialCheck, AStartDoesNotRequireTheSourceYet) {
                                          "'/nonexistent/frame_%04d.png': folder '/nonexistent' does not exist"),
             std::string::npos)
       << checked.error().message;
+}
+
+// The shipped bundle example, on the frames the build renders for it.
+TEST(FiducialCheck, TheShippedBundleExampleIsAccepted) {
+  const CheckRun run = check_file(COVTRACK_SOURCE_DIR "/config/fiducial_bundle.toml");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("fiducial_bundle.toml: OK, 1 device(s)"), std::string::npos) << run.output;
 }

@@ -147,8 +147,9 @@ TEST(Serial6dofEndToEnd, EachProtocolThroughTheDaemonHasChiSquareNees) {
 TEST(Serial6dofEndToEnd, AResettingUnitDoesNotDelayAnotherDevice) {
   const std::string url = url_for(7712);
   Collector c(url);
-  // A reset stalls for seconds; 20 Hz keeps the 2-period bound (100 ms) clear of the
-  // scheduling hiccups of a loaded 2-core machine while still catching any stall.
+  // A reset stalls for 2.5 s: a device held up by it would show a gap of seconds. The
+  // bound is a quarter of that, far above the scheduling hiccups of a loaded 2-core
+  // machine (up to 150 ms seen with four builds beside the suite).
   const double steady_rate_hz = 20;
   Emulated resetting = emulate("slow", Model::Fastrak, {1}, 2.5, 60);
   Emulated steady = emulate("steady", Model::Patriot, {1}, 0.3, steady_rate_hz);
@@ -178,7 +179,7 @@ TEST(Serial6dofEndToEnd, AResettingUnitDoesNotDelayAnotherDevice) {
     max_gap_us = std::max(max_gap_us, fast[i].measurement_time_us - fast[i - 1].measurement_time_us);
   EXPECT_GE(fast.size(), 150u) << "the steady device should have reported through both resets";
   const double period_us = 1e6 / steady_rate_hz;
-  EXPECT_LT(max_gap_us, 2 * period_us) << "largest gap " << max_gap_us << " us";
+  EXPECT_LT(max_gap_us, 2.5e6 / 4) << "largest gap " << max_gap_us << " us";
   std::cout << "[ ISOLATION ] across 2 resets (2.5 s each) of another unit: " << fast.size()
             << " reports, largest gap " << max_gap_us / 1e3 << " ms = " << max_gap_us / period_us
             << " periods\n";

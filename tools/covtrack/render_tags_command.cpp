@@ -1,8 +1,10 @@
 // `covtrack render-tags`: AprilTags at known poses through a camera's image formation
 // (lens distortion from the calibration file, blur and defocus, vignetting, shot and
 // read noise, a tone curve, JPEG: tag_image_formation.hpp), written as an image sequence
-// (or a video) plus a truth file. The fiducial tracker's emulated camera: point its
-// `source` at the output.
+// (or a video) plus a truth file. Tags are given one by one, or as the tag bundles a
+// daemon config declares (a board, an object carrying tags) at a pose. The fiducial
+// tracker's emulated camera: point its `source` at the output.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -13,10 +15,12 @@
 #include <vector>
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "commands.hpp"
+#include "covtrack/devices/fiducial/fiducial_config.hpp"
 #include "covtrack/devices/fiducial/tag_image_formation.hpp"
 
 namespace covtrack::cli {
@@ -24,7 +28,8 @@ namespace {
 
 struct RenderArgs {
   std::string camera, family = "tag36h11", out, video;
-  std::vector<std::string> tags;
+  std::vector<std::string> tags, bundles;
+  std::string bundles_from;
   int frames = 60;
   double swing_deg = 20, period_frames = 60;
   double noise = 3, blur = 0.8, black = 30, white = 220, background = 128;
@@ -34,9 +39,9 @@ struct RenderArgs {
   std::uint64_t seed = 1;
 };
 
-// "id,size_m,x,y,z,roll_deg,pitch_deg,yaw_deg": T_camera_tag, angles applied as
-// Rz(roll) Ry(yaw) Rx(pitch) in the camera frame.
-std::optional<fiducial::RenderedTag> parse_tag(const std::string& text, std::string& error) {
+// The comma-separated numbers of `text` (an option's value), or nothing and an error.
+std::optional<std::vector<double>> parse_numbers(const std::string& option, const std::string& text,
+                                                 std::string& error) {
   std::vector<double> v;
   std::stringstream ss(text);
   for (std::string item; std::getline(ss, item, ',');) {
@@ -45,26 +50,64 @@ std::optional<fiducial::RenderedTag> parse_tag(const std::string& text, std::str
       v.push_back(std::stod(item, &used));
       if (used != item.size()) throw std::invalid_argument(item);
     } catch (const std::exception&) {
-      error = fmt::format("--tag '{}': '{}' is not a number", text, item);
+      error = fmt::format("{} '{}': '{}' is not a number", option, text, item);
       return std::nullopt;
     }
   }
-  if (v.size() != 8 || v[0] < 0 || !(v[1] > 0) || !(v[4] > 0)) {
+  return v;
+}
+
+// x, y, z, roll_deg, pitch_deg, yaw_deg as a pose in the camera frame, the angles applied
+// as Rz(roll) Ry(yaw) Rx(pitch).
+Pose camera_pose(const double* v) {
+  const double k = M_PI / 180;
+  Pose T = Pose::Identity();
+  T.linear() = (Eigen::AngleAxisd(v[3] * k, Vec3::UnitZ()) * Eigen::AngleAxisd(v[5] * k, Vec3::UnitY()) *
+                Eigen::AngleAxisd(v[4] * k, Vec3::UnitX())).toRotationMatrix();
+  T.translation() = Vec3(v[0], v[1], v[2]);
+  return T;
+}
+
+// "id,size_m,x,y,z,roll_deg,pitch_deg,yaw_deg": T_camera_tag.
+std::optional<fiducial::RenderedTag> parse_tag(const std::string& text, std::string& error) {
+  const auto v = parse_numbers("--tag", text, error);
+  if (!v) return std::nullopt;
+  if (v->size() != 8 || (*v)[0] < 0 || !((*v)[1] > 0) || !((*v)[4] > 0)) {
     error = fmt::format("--tag '{}': expected id,size_m,x,y,z,roll_deg,pitch_deg,yaw_deg with "
                         "size_m > 0 and z > 0",
                         text);
     return std::nullopt;
   }
-  const double k = M_PI / 180;
-  fiducial::RenderedTag t;
-  t.id = static_cast<int>(v[0]);
-  t.size_m = v[1];
-  t.T_camera_tag = Pose::Identity();
-  t.T_camera_tag.linear() = (Eigen::AngleAxisd(v[5] * k, Vec3::UnitZ()) *
-                             Eigen::AngleAxisd(v[7] * k, Vec3::UnitY()) *
-                             Eigen::AngleAxisd(v[6] * k, Vec3::UnitX())).toRotationMatrix();
-  t.T_camera_tag.translation() = Vec3(v[2], v[3], v[4]);
-  return t;
+  return fiducial::RenderedTag{static_cast<int>((*v)[0]), (*v)[1], camera_pose(v->data() + 2)};
+}
+
+// A bundle of the --bundles-from config where "NAME,x,y,z,roll_deg,pitch_deg,yaw_deg" puts it
+// (T_camera_bundle).
+struct PlacedBundle {
+  fiducial::TagBundle bundle;
+  Pose T_camera_bundle;
+};
+
+std::optional<PlacedBundle> parse_bundle(const std::string& text, const std::vector<fiducial::TagBundle>& known,
+                                         std::string& error) {
+  const auto comma = text.find(',');
+  const std::string name = text.substr(0, comma);
+  const auto bundle = std::find_if(known.begin(), known.end(), [&](const auto& b) { return b.name == name; });
+  if (bundle == known.end()) {
+    std::vector<std::string> names;
+    for (const auto& b : known) names.push_back(b.name);
+    error = fmt::format("--bundle '{}': no bundle '{}' in --bundles-from (bundles there: {})", text, name,
+                        names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", ")));
+    return std::nullopt;
+  }
+  const auto v = comma == std::string::npos ? std::optional<std::vector<double>>{}
+                                            : parse_numbers("--bundle", text.substr(comma + 1), error);
+  if (!v || v->size() != 6 || !((*v)[2] > 0)) {
+    if (error.empty())
+      error = fmt::format("--bundle '{}': expected NAME,x,y,z,roll_deg,pitch_deg,yaw_deg with z > 0", text);
+    return std::nullopt;
+  }
+  return PlacedBundle{*bundle, camera_pose(v->data())};
 }
 
 int run_render(const RenderArgs& a) {
@@ -77,10 +120,31 @@ int run_render(const RenderArgs& a) {
     std::string error;
     auto t = parse_tag(text, error);
     if (!t) return fmt::print(stderr, "covtrack render-tags: {}\n", error), 2;
-    if (!(*family)->cells(t->id))
-      return fmt::print(stderr, "covtrack render-tags: {}\n", (*family)->cells(t->id).error().message), 2;
     tags.push_back(*t);
   }
+  std::vector<PlacedBundle> bundles;
+  if (!a.bundles.empty()) {
+    if (a.bundles_from.empty())
+      return fmt::print(stderr, "covtrack render-tags: --bundle needs --bundles-from CONFIG\n"), 2;
+    auto known = fiducial::read_config_bundles(a.bundles_from);
+    if (!known) return fmt::print(stderr, "covtrack render-tags: {}\n", known.error().message), 2;
+    for (const auto& text : a.bundles) {
+      std::string error;
+      auto b = parse_bundle(text, *known, error);
+      if (!b) return fmt::print(stderr, "covtrack render-tags: {}\n", error), 2;
+      bundles.push_back(*b);
+    }
+  }
+  if (tags.empty() && bundles.empty())
+    return fmt::print(stderr, "covtrack render-tags: nothing to render: give --tag or --bundle\n"), 2;
+  for (const auto& t : tags)
+    if (!(*family)->cells(t.id))
+      return fmt::print(stderr, "covtrack render-tags: {}\n", (*family)->cells(t.id).error().message), 2;
+  for (const auto& b : bundles)
+    for (const auto& t : b.bundle.tags)
+      if (!(*family)->cells(t.id))
+        return fmt::print(stderr, "covtrack render-tags: bundle {}: {}\n", b.bundle.name,
+                          (*family)->cells(t.id).error().message), 2;
   std::filesystem::create_directories(a.out);
   cv::VideoWriter video;
   if (!a.video.empty()) {
@@ -92,6 +156,11 @@ int run_render(const RenderArgs& a) {
   }
   std::ofstream truth(std::filesystem::path(a.out) / "truth.csv");
   truth << "# frame,id,size_m,x_m,y_m,z_m,qw,qx,qy,qz  (T_camera_tag; camera: OpenCV frame)\n";
+  std::ofstream bundle_truth;
+  if (!bundles.empty()) {
+    bundle_truth.open(std::filesystem::path(a.out) / "bundle_truth.csv");
+    bundle_truth << "# frame,name,x_m,y_m,z_m,qw,qx,qy,qz  (T_camera_bundle; camera: OpenCV frame)\n";
+  }
   // Levels are given in grey levels of a linear camera (gamma 1); the tone curve, if any,
   // applies on top, as a camera's does.
   fiducial::ImageFormation formation;
@@ -105,10 +174,20 @@ int run_render(const RenderArgs& a) {
   std::mt19937_64 rng(a.seed);
   for (int f = 0; f < a.frames; ++f) {
     // Each tag swings about its own vertical axis, so the frames show motion.
+    // Each tag and each bundle swings about its own vertical axis, so the frames show motion.
     const double swing = a.swing_deg * M_PI / 180 * std::sin(2 * M_PI * f / a.period_frames);
-    std::vector<fiducial::RenderedTag> now = tags;
-    for (auto& t : now) {
-      t.T_camera_tag.linear() = t.T_camera_tag.linear() * Eigen::AngleAxisd(swing, Vec3::UnitY()).toRotationMatrix();
+    const Pose turn(Eigen::AngleAxisd(swing, Vec3::UnitY()).toRotationMatrix());
+    std::vector<fiducial::RenderedTag> now;
+    for (const auto& t : tags) now.push_back({t.id, t.size_m, t.T_camera_tag * turn});
+    for (const auto& b : bundles) {
+      const Pose T_camera_bundle = b.T_camera_bundle * turn;
+      for (const auto& t : b.bundle.tags) now.push_back({t.id, t.size_m, T_camera_bundle * t.T_bundle_tag});
+      const Eigen::Quaterniond q(T_camera_bundle.rotation());
+      const Vec3 p = T_camera_bundle.translation();
+      bundle_truth << fmt::format("{},{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f}\n", f, b.bundle.name, p.x(),
+                                  p.y(), p.z(), q.w(), q.x(), q.y(), q.z());
+    }
+    for (const auto& t : now) {
       const Eigen::Quaterniond q(t.T_camera_tag.rotation());
       const Vec3 p = t.T_camera_tag.translation();
       truth << fmt::format("{},{},{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f}\n", f, t.id,
@@ -132,7 +211,12 @@ void add_render_tags_command(CLI::App& app) {
   cmd->add_option("--camera", args->camera, "OpenCV calibration file")->required();
   cmd->add_option("--out", args->out, "output folder (frames and truth.csv)")->required();
   cmd->add_option("--tag", args->tags, "id,size_m,x,y,z,roll_deg,pitch_deg,yaw_deg (T_camera_tag; "
-                                       "repeat for more tags)")->required();
+                                       "repeat for more tags)");
+  cmd->add_option("--bundle", args->bundles, "NAME,x,y,z,roll_deg,pitch_deg,yaw_deg: every tag of the "
+                                             "bundle NAME of --bundles-from, at T_camera_bundle (repeat for "
+                                             "more); its truth goes to bundle_truth.csv");
+  cmd->add_option("--bundles-from", args->bundles_from, "a covtrackd config whose fiducial devices declare "
+                                                        "the bundles (their [[bundles]])");
   cmd->add_option("--family", args->family, "AprilTag family")->capture_default_str();
   cmd->add_option("--video", args->video, "write this video file (FFV1) instead of PNG frames");
   cmd->add_option("--frames", args->frames, "frame count")->capture_default_str()->check(CLI::Range(1, 1000000));

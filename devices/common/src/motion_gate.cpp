@@ -79,7 +79,9 @@ GateVerdict MotionGate::check(const Pose& T, const Mat6& covariance, TrackingSta
 
   Vec6 nu;
   nu << T.translation() - position_, so3_log(T.linear() * rotation_.transpose());
-  const Mat6 S = P_.topLeftCorner<6, 6>() + C;
+  // The host times a record only to within about a report period (records are read in
+  // bursts, the reading thread shares the machine): along the motion, that is distance.
+  const Mat6 S = P_.topLeftCorner<6, 6>() + C + velocity_ * velocity_.transpose() * (min_interval_s_ * min_interval_s_);
   adapt(nu, C);
   const double d2 = nu.dot(S.ldlt().solve(nu));
   if (d2 <= kWidenChi2) {

@@ -1,11 +1,14 @@
 #include "covtrack/devices/fiducial/fiducial_config.hpp"
 
+#include <deque>
 #include <filesystem>
 
 #include <fmt/format.h>
 
 #include "covtrack/devices/device_keys.hpp"
 #include "covtrack/devices/fiducial/frame_source.hpp"
+#include "covtrack/devices/pose_keys.hpp"
+#include "covtrack/protocol/channels.hpp"
 
 namespace covtrack::fiducial {
 
@@ -63,8 +66,13 @@ const TableSpec& fiducial_device_spec() {
          "frames", 1, 10000},
         {"image_jpeg_quality", ValueType::Integer, "", "80", "publish_images: JPEG quality (higher: "
          "larger, sharper)", 1, 100},
-        {"tags", ValueType::TableArray, "", "", "the tag map: [[devices.<name>.tags]]; tags not "
-         "listed are ignored"},
+        {"tags", ValueType::TableArray, "", "[]", "the tag map: [[devices.<name>.tags]], each tag a "
+         "sensor of its own; tags neither here nor in a bundle are ignored"},
+        {"bundles", ValueType::TableArray, "", "[]", "tag bundles: [[devices.<name>.bundles]], each a "
+         "rigid set of tags posed as one sensor from all their corners (devices/fiducial/README.md)"},
+        {"bundle_consistency_chi2", ValueType::Float, "", "40", "a bundle's tag whose own pose is further "
+         "than this chi-square (6 dof) from where its other tags put it disagrees: it is left out (or, "
+         "without a majority, covered) and the bundle is DEGRADED", 0, 1e12},
     };
     s.keys.insert(s.keys.end(), own.begin(), own.end());
     return s;
@@ -84,10 +92,75 @@ const TableSpec& fiducial_tag_spec() {
   return spec;
 }
 
+const TableSpec& fiducial_bundle_spec() {
+  static const TableSpec spec{
+      "devices.<name>.bundles[] (type = \"fiducial\")",
+      "fiducial driver",
+      {
+          {"name", ValueType::String, "", "", "the bundle's sensor name (1-23 of A-Z a-z 0-9 _ -); its pose "
+           "is T_camera_bundle"},
+          {"publish_tags", ValueType::Boolean, "", "false", "also publish each of its tags on its own, as "
+           "tag<id>"},
+          {"tags", ValueType::TableArray, "", "", "its tags: [[devices.<name>.bundles.tags]]"},
+      }};
+  return spec;
+}
+
+const TableSpec& fiducial_bundle_tag_spec() {
+  static const TableSpec spec = [] {
+    TableSpec s{"devices.<name>.bundles[].tags[] (type = \"fiducial\"; the pose is T_bundle_tag: parent the "
+                "bundle, child the tag)",
+                "fiducial driver",
+                {
+                    {"id", ValueType::Integer, "", "", "tag id in the family; a tag belongs to one bundle at "
+                     "most, and then not to the tag map", 0, 1e6},
+                    {"size_m", ValueType::Float, "m", "", "edge of the detected square", 1e-4, 100},
+                }};
+    const auto pose = pose_keys();
+    s.keys.insert(s.keys.end(), pose.begin(), pose.end());
+    return s;
+  }();
+  return spec;
+}
+
 namespace {
 std::string relative_to_config(const std::string& path, const std::string& config_file) {
   if (path.empty() || std::filesystem::path(path).is_absolute()) return path;
   return (std::filesystem::path(config_file).parent_path() / path).string();
+}
+
+// Who claims a tag id: the tag map, or a bundle (by its name, which cannot be this).
+constexpr const char* kTagMap = "[[tags]]";
+
+// One [[bundles]] entry. `owner` maps every tag id already claimed to its claimant, so
+// that a tag is claimed once.
+TagBundle read_bundle(TableReader& r, std::map<int, std::string>& owner) {
+  TagBundle b;
+  b.name = r.string("name");
+  if (r.has("name") && !is_valid_name(b.name))
+    r.error("name", fmt::format("'{}' is not a sensor name (1-23 of A-Z a-z 0-9 _ -)", b.name));
+  b.publish_tags = r.boolean("publish_tags", false);
+  const auto tables = r.tables("tags");
+  if (r.has("tags") && tables.empty()) r.error("tags", "a bundle needs at least one tag");
+  for (std::size_t i = 0; i < tables.size(); ++i) {
+    TableReader tr(*tables[i], r.path(fmt::format("tags[{}]", i)), fiducial_bundle_tag_spec(), r.file(), r.errors());
+    BundleTag t;
+    t.id = static_cast<int>(tr.integer("id", 0));
+    t.size_m = tr.number("size_m", 0.1);
+    t.T_bundle_tag = read_pose(tr);
+    if (const auto claimed = owner.find(t.id); tr.has("id") && claimed != owner.end())
+      tr.error("id", claimed->second == kTagMap
+                         ? fmt::format("tag {} is in the tag map ([[tags]]) too: list it once (publish_tags = "
+                                       "true publishes a bundle's tags on their own)", t.id)
+                     : claimed->second == b.name
+                         ? fmt::format("tag {} is listed twice in bundle '{}'", t.id, b.name)
+                         : fmt::format("tag {} is in bundle '{}' already: a tag belongs to one bundle at most",
+                                       t.id, claimed->second));
+    else
+      owner[t.id] = b.name;
+    b.tags.push_back(t);
+  }
+  return b;
 }
 }  // namespace
 
@@ -137,8 +210,48 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
     if (c.tag_size_m.count(id)) tr.error("id", fmt::format("tag {} is listed twice", id));
     c.tag_size_m[id] = size;
   }
-  if (c.tag_size_m.empty()) r.error("tags", "needs at least one [[tags]] entry (id, size_m)");
+  c.bundle_consistency_chi2 = r.number("bundle_consistency_chi2", c.bundle_consistency_chi2);
+  std::map<int, std::string> owner;  // who claims each tag id
+  for (const auto& [id, size] : c.tag_size_m) owner[id] = kTagMap;
+  std::deque<TableReader> bundle_readers;  // kept for the checks that need every bundle read
+  for (const toml::table* t : r.tables("bundles")) {
+    TableReader& br = bundle_readers.emplace_back(
+        *t, r.path(fmt::format("bundles[{}]", bundle_readers.size())), fiducial_bundle_spec(), r.file(), r.errors());
+    TagBundle b = read_bundle(br, owner);
+    for (const TagBundle& other : c.bundles)
+      if (other.name == b.name) br.error("name", fmt::format("bundle '{}' is named twice", b.name));
+    c.bundles.push_back(b);
+  }
+  // A bundle named like a tag's sensor would share its stream.
+  for (std::size_t i = 0; i < c.bundles.size(); ++i)
+    for (const auto& [id, claimant] : owner)
+      if (c.bundles[i].name == fmt::format("tag{}", id))
+        bundle_readers[i].error("name", fmt::format("'{}' is the sensor name of tag {}", c.bundles[i].name, id));
+  if (c.tag_size_m.empty() && c.bundles.empty())
+    r.error("tags", "needs at least one [[tags]] entry (id, size_m) or [[bundles]] entry");
   return c;
+}
+
+Result<std::vector<TagBundle>> read_config_bundles(const std::string& config_file) {
+  auto text = read_config_text(config_file);
+  if (!text) return std::unexpected(text.error());
+  auto root = parse_toml(*text, config_file);
+  if (!root) return std::unexpected(root.error());
+  ConfigErrors errors;
+  std::vector<TagBundle> bundles;
+  if (const toml::table* devices = root->get_as<toml::table>("devices"))
+    for (const auto& [name, node] : *devices) {
+      const toml::table* device = node.as_table();
+      if (!device || device->get_as<std::string>("type") == nullptr ||
+          device->get_as<std::string>("type")->get() != "fiducial")
+        continue;
+      const std::string device_name(name.str());
+      TableReader r(*device, "devices." + device_name, fiducial_device_spec(), config_file, errors);
+      const FiducialConfig c = read_fiducial_config(r, device_name);
+      bundles.insert(bundles.end(), c.bundles.begin(), c.bundles.end());
+    }
+  if (!errors.empty()) return fail(errors.joined());
+  return bundles;
 }
 
 }  // namespace covtrack::fiducial

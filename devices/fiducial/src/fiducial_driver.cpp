@@ -4,6 +4,7 @@
 #include <chrono>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -11,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "covtrack/devices/fiducial/bundle_pose.hpp"
 #include "covtrack/devices/fiducial/frame_source.hpp"
 #include "covtrack/devices/fiducial/raw_detection.hpp"
 #include "covtrack/devices/fiducial/tag_pose.hpp"
@@ -31,7 +33,11 @@ std::string view_detail(bool mapped_in_view, const std::set<int>& unmapped) {
 
 class FiducialDriver final : public Driver {
  public:
-  explicit FiducialDriver(const FiducialConfig& config) : config_(config) {}
+  explicit FiducialDriver(const FiducialConfig& config) : config_(config) {
+    for (const auto& [id, size] : config_.tag_size_m) tags_[id] = {{id, size, Pose::Identity()}, std::nullopt};
+    for (std::size_t b = 0; b < config_.bundles.size(); ++b)
+      for (const BundleTag& t : config_.bundles[b].tags) tags_[t.id] = {t, b};
+  }
 
   Result<void> run(SampleSink& sink, std::stop_token stop) override {
     try {
@@ -93,57 +99,79 @@ class FiducialDriver final : public Driver {
 
   void process(SampleSink& sink, const cv::Mat& gray, std::uint32_t index, std::int64_t time_us) {
     RawFrame raw{index, time_us, estimate_image_noise(gray), {}};
-    std::set<int> seen, unmapped;  // seen: posed
-    std::map<int, int> copies;     // detections per mapped id in this frame
+    std::set<std::string> posed;
+    std::set<int> unmapped;
+    std::map<int, int> copies;  // detections per mapped id in this frame
+    std::map<std::size_t, std::vector<BundleObservation>> in_bundle;  // per bundle, its tags posed
     for (const Detection& det : detector_->detect(gray)) {
-      const auto size = config_.tag_size_m.find(det.id);
-      if (size == config_.tag_size_m.end()) {
+      const auto mapped = tags_.find(det.id);
+      if (mapped == tags_.end()) {
         unmapped.insert(det.id);
         continue;
       }
       // One sensor per id: a second print of the same tag (or a false detection) cannot be
       // told from the first, so only the first is posed and the rest are reported below.
       if (++copies[det.id] > 1) continue;
+      const MappedTag& tag = mapped->second;
       const CornerInputs inputs = measure_corner_inputs(gray, det, detector_->family(), raw.image_noise);
       const CornerNoise noise = config_.noise.noise(inputs);
-      auto pose = estimate_tag_pose(camera_, det.corners_px, size->second, noise, config_.ambiguity_chi2);
+      auto pose = estimate_tag_pose(camera_, det.corners_px, tag.tag.size_m, noise, config_.ambiguity_chi2);
       if (!pose) {
         sink.count_error(fmt::format("tag {}: {}", det.id, pose.error().message));
         continue;
       }
-      seen.insert(det.id);
       RawTag rt{det, inputs.contrast, {pose->best}};
       if (pose->second) rt.solutions.push_back(*pose->second);
       raw.tags.push_back(rt);
-
-      const std::string sensor = fmt::format("tag{}", det.id);
-      PoseSample s{sensor, config_.parent_frame, sensor, time_us};
-      s.T_parent_child = pose->best.T_camera_tag;
-      s.covariance = pose->covariance;
-      s.status = pose->ambiguous ? TrackingStatus::Degraded : TrackingStatus::Ok;
-      last_pose_[det.id] = s.T_parent_child;
-      sink.pose(s);
+      if (tag.bundle) in_bundle[*tag.bundle].push_back({tag.tag, *pose});
+      if (!tag.bundle || config_.bundles[*tag.bundle].publish_tags) {
+        const std::string sensor = fmt::format("tag{}", det.id);
+        publish(sink, sensor, time_us, pose->best.T_camera_tag, pose->covariance, pose->ambiguous);
+        posed.insert(sensor);
+      }
     }
     for (const auto& [id, n] : copies)
       if (n > 1)
         sink.count_error(fmt::format("tag {} detected {} times in frame {}: only the first is posed (one "
                                      "sensor per id; print each tag once, or give the copies other ids)",
                                      id, n, index));
-    // Tags seen before and not now: LOST, so that a client tells "not seen" from "lost message".
-    for (const auto& [id, last] : last_pose_) {
-      if (seen.count(id)) continue;
-      const std::string sensor = fmt::format("tag{}", id);
+    std::vector<std::string> details;
+    for (const auto& [b, observations] : in_bundle) {
+      const std::string& name = config_.bundles[b].name;
+      auto pose = estimate_bundle_pose(camera_, observations, config_.ambiguity_chi2, config_.bundle_consistency_chi2);
+      if (!pose) {
+        sink.count_error(fmt::format("bundle {}: {}", name, pose.error().message));
+        continue;
+      }
+      publish(sink, name, time_us, pose->T_camera_bundle, pose->covariance, pose->degraded());
+      posed.insert(name);
+      if (pose->degraded()) details.push_back(fmt::format("{} DEGRADED: {}", name, pose->why_degraded));
+    }
+    // Sensors seen before and not now: LOST, so that a client tells "not seen" from "lost message".
+    for (const auto& [sensor, last] : last_pose_) {
+      if (posed.count(sensor)) continue;
       PoseSample s{sensor, config_.parent_frame, sensor, time_us};
       s.T_parent_child = last;
       s.covariance = Mat6::Identity() * std::numeric_limits<double>::infinity();
       s.status = TrackingStatus::Lost;
       sink.pose(s);
     }
-    sink.running(view_detail(!copies.empty(), unmapped));
+    if (const std::string view = view_detail(!copies.empty(), unmapped); !view.empty()) details.insert(details.begin(), view);
+    sink.running(fmt::format("{}", fmt::join(details, "; ")));
     if (config_.publish_raw) {
       const auto bytes = encode_raw_frame(raw);
       sink.raw(ByteDirection::FromDevice, bytes.data(), bytes.size());
     }
+  }
+
+  void publish(SampleSink& sink, const std::string& sensor, std::int64_t time_us, const Pose& T, const Mat6& covariance,
+               bool degraded) {
+    PoseSample s{sensor, config_.parent_frame, sensor, time_us};
+    s.T_parent_child = T;
+    s.covariance = covariance;
+    s.status = degraded ? TrackingStatus::Degraded : TrackingStatus::Ok;
+    last_pose_[sensor] = T;
+    sink.pose(s);
   }
 
   // The frame as captured (colour if it is), after its poses: a see-through view of the
@@ -164,7 +192,13 @@ class FiducialDriver final : public Driver {
   CameraModel camera_;
   std::unique_ptr<TagDetector> detector_;
   std::uint64_t frames_published_ = 0;  // frames considered for publish_images (every n-th goes)
-  std::map<int, Pose> last_pose_;
+  // Every tag the driver poses: its size and place on its bundle, if it is in one.
+  struct MappedTag {
+    BundleTag tag;
+    std::optional<std::size_t> bundle;
+  };
+  std::map<int, MappedTag> tags_;
+  std::map<std::string, Pose> last_pose_;  // per sensor
 };
 
 }  // namespace

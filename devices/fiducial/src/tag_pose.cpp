@@ -26,12 +26,6 @@ cv::Point2d corner_step(const cv::Point2d& na, const cv::Point2d& nb, double ra,
   return {(ra * nb.y - rb * na.y) / det, (rb * na.x - ra * nb.x) / det};
 }
 
-// AprilTag 3's corner order, which is also the order SOLVEPNP_IPPE_SQUARE requires.
-std::array<Vec3, 4> tag_corners(double size_m) {
-  const double h = size_m / 2;
-  return {Vec3(-h, h, 0), Vec3(h, h, 0), Vec3(h, -h, 0), Vec3(-h, -h, 0)};
-}
-
 Pose pose_of(const cv::Mat& rvec, const cv::Mat& tvec) {
   cv::Mat R;
   cv::Rodrigues(rvec, R);
@@ -56,6 +50,12 @@ double sse(const CameraModel& cam, const Pose& T, const std::array<Vec3, 4>& obj
 }
 
 }  // namespace
+
+// AprilTag 3's corner order, which is also the order SOLVEPNP_IPPE_SQUARE requires.
+std::array<Vec3, 4> tag_corner_points(double size_m) {
+  const double h = size_m / 2;
+  return {Vec3(-h, h, 0), Vec3(h, h, 0), Vec3(h, -h, 0), Vec3(-h, -h, 0)};
+}
 
 std::array<cv::Point2d, 4> edge_outward_normals(const std::array<cv::Point2d, 4>& c) {
   const cv::Point2d centre = (c[0] + c[1] + c[2] + c[3]) / 4.0;
@@ -112,21 +112,22 @@ Eigen::Matrix<double, 8, 8> corner_covariance(const std::array<cv::Point2d, 4>& 
   return cov;
 }
 
+Eigen::Matrix<double, 2, 6> point_jacobian(const CameraModel& cam, const Pose& T, const Vec3& X) {
+  const Vec3 p = T * X;
+  // T Exp(xi) X ~ T (X + rho + phi x X): dp/dxi = R [I, -[X]x].
+  const Mat3 R = T.rotation();
+  Eigen::Matrix<double, 3, 6> dp;
+  dp << R, -R * skew(X);
+  Eigen::Matrix<double, 2, 3> du;
+  const double iz = 1 / p.z();
+  du << cam.fx * iz, 0, -cam.fx * p.x() * iz * iz, 0, cam.fy * iz, -cam.fy * p.y() * iz * iz;
+  return du * dp;
+}
+
 CornerJacobian corner_jacobian(const CameraModel& cam, const Pose& T, double size_m) {
   CornerJacobian J;
-  const Mat3 R = T.rotation();
-  const auto corners = tag_corners(size_m);
-  for (int i = 0; i < 4; ++i) {
-    const Vec3& X = corners[i];
-    const Vec3 p = T * X;
-    // T Exp(xi) X ~ T (X + rho + phi x X): dp/dxi = R [I, -[X]x].
-    Eigen::Matrix<double, 3, 6> dp;
-    dp << R, -R * skew(X);
-    Eigen::Matrix<double, 2, 3> du;
-    const double iz = 1 / p.z();
-    du << cam.fx * iz, 0, -cam.fx * p.x() * iz * iz, 0, cam.fy * iz, -cam.fy * p.y() * iz * iz;
-    J.block<2, 6>(2 * i, 0) = du * dp;
-  }
+  const auto corners = tag_corner_points(size_m);
+  for (int i = 0; i < 4; ++i) J.block<2, 6>(2 * i, 0) = point_jacobian(cam, T, corners[i]);
   return J;
 }
 
@@ -165,7 +166,7 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
   const Eigen::Matrix<double, 8, 8> corner_cov =
       corner_covariance({image[0], image[1], image[2], image[3]}, noise);
 
-  const auto object = tag_corners(size_m);
+  const auto object = tag_corner_points(size_m);
   std::vector<cv::Point3d> obj;
   for (const Vec3& X : object) obj.emplace_back(X.x(), X.y(), X.z());
   const cv::Mat K(cam.K());
@@ -198,6 +199,8 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
   TagPose out;
   out.best = solutions[0];
   out.corner_sigma_px = sigma;
+  out.corners_px = {image[0], image[1], image[2], image[3]};
+  out.corner_covariance = corner_cov;
   out.covariance = pose_covariance(corner_jacobian(cam, out.best.T_camera_tag, size_m), corner_cov);
   out.ambiguity_chi2 = std::numeric_limits<double>::infinity();
   if (solutions.size() > 1) {

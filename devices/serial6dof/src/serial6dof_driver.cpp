@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include <fmt/format.h>
 
@@ -80,8 +81,16 @@ class Serial6dofDriver final : public Driver {
       }
       const auto now = Clock::now();
       const std::int64_t time_us = now_us() - std::llround(config_.latency_s * 1e6);
-      for (auto& item : session.feed(bytes))
-        if (auto* record = std::get_if<TrackerRecord>(&item)) report(sink, *record, now, time_us);
+      const auto items = session.feed(bytes);
+      // Records that arrive together were measured one report period apart, the last
+      // one just now: a shared receive time would misplace all but the last (and a
+      // moving receiver's prediction with them).
+      std::map<int, int> left;  // station -> records still to come in this read
+      for (const auto& item : items)
+        if (const auto* record = std::get_if<TrackerRecord>(&item)) ++left[record->station];
+      for (const auto& item : items)
+        if (const auto* record = std::get_if<TrackerRecord>(&item))
+          report(sink, *record, now, time_us - std::llround(--left[record->station] * config_.period_s() * 1e6));
       for (; resyncs < session.resyncs(); ++resyncs) sink.count_resync();
       if (session.bad_records() > bad) {
         bad = session.bad_records();

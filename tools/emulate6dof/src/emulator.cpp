@@ -83,6 +83,7 @@ class Emulator::Impl {
         if (!reply.empty()) (void)pty_.write(reply);
       }
       if (Clock::now() < next_report) continue;
+      const auto sampled = next_report;  // a real unit samples on its own clock, late or not
       next_report += period;
       if (Clock::now() > next_report + 10 * period) next_report = Clock::now() + period;  // stalled
       if (resetting || e.hung_ || !unit_->streaming()) continue;
@@ -91,7 +92,7 @@ class Emulator::Impl {
         trouble = true;
         next_trouble += duration_cast<Clock::duration>(duration<double>(config_.trouble_every_s));
       }
-      report(e, trouble, on_truth);
+      report(e, trouble, on_truth, sampled);
     }
   }
 
@@ -112,9 +113,9 @@ class Emulator::Impl {
     return pty_.plugged();
   }
 
-  void report(Emulator& e, bool trouble, const TruthCallback& on_truth) {
-    const std::int64_t time_us = now_us();
-    const double t_s = duration<double>(Clock::now() - started_).count();
+  void report(Emulator& e, bool trouble, const TruthCallback& on_truth, Clock::time_point sampled) {
+    const std::int64_t time_us = now_us() - duration_cast<microseconds>(Clock::now() - sampled).count();
+    const double t_s = duration<double>(sampled - started_).count();
     std::vector<TrackerRecord> records;
     for (std::size_t i = 0; i < config_.stations.size(); ++i) {
       const auto& st = config_.stations[i];

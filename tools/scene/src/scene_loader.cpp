@@ -1,12 +1,12 @@
 #include <algorithm>
 #include <filesystem>
 #include <functional>
-#include <numbers>
 
 #include <fmt/format.h>
 
 #include "covtrack/devices/config_reader.hpp"
 #include "covtrack/devices/covariance_keys.hpp"
+#include "covtrack/devices/pose_keys.hpp"
 #include "covtrack/scene/scene.hpp"
 
 namespace covtrack::scene {
@@ -39,12 +39,6 @@ const TableSpec& transform_spec() {
     TableSpec t{"transform[]", "covtrack regions",
                 {{"parent", ValueType::String, "", "", "parent frame"},
                  {"child", ValueType::String, "", "", "child frame (has exactly one parent)"},
-                 {"position_m", ValueType::FloatArray, "m", "[0, 0, 0]",
-                  "child origin in the parent frame", -1e6, 1e6, 3},
-                 {"rotation_rpy_deg", ValueType::FloatArray, "deg", "[0, 0, 0]",
-                  "roll, pitch, yaw: R = Rz(yaw) Ry(pitch) Rx(roll); or orientation_wxyz", -360, 360, 3},
-                 {"orientation_wxyz", ValueType::FloatArray, "", "",
-                  "unit quaternion w x y z; instead of rotation_rpy_deg", -1, 1, 4},
                  {"stream", ValueType::String, "", "",
                   "tracked edge: the device/sensor stream that updates it"},
                  {"max_speed_mps", ValueType::Float, "m/s", "0",
@@ -53,6 +47,8 @@ const TableSpec& transform_spec() {
                   "tracked edge: bound on angular speed", 0, 1e3},
                  {"keyframe", ValueType::TableArray, "", "[]",
                   "tracked edge, offline: scripted reports, [[transform.keyframe]]"}}};
+    const auto pose = pose_keys();  // after parent and child, as the schema lists them
+    t.keys.insert(t.keys.begin() + 2, pose.begin(), pose.end());
     const auto cov = covariance_keys();
     t.keys.insert(t.keys.end(), cov.begin(), cov.end());
     return t;
@@ -99,28 +95,6 @@ const TableSpec& object_spec() {
                             {"augmentations", ValueType::StringArray, "", "[\"outline\"]",
                              "one per level: outline, region or label (one more than thresholds)"}}};
   return s;
-}
-
-Pose read_pose(TableReader& r) {
-  Pose T = Pose::Identity();
-  T.translation() = r.vec3("position_m");
-  if (r.has("orientation_wxyz") && r.has("rotation_rpy_deg")) {
-    r.error("orientation_wxyz", "give orientation_wxyz or rotation_rpy_deg, not both");
-  } else if (r.has("orientation_wxyz")) {
-    const auto q = r.numbers("orientation_wxyz");
-    if (q.size() == 4) {
-      const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
-      if (std::abs(quat.norm() - 1) > 1e-6)
-        r.error("orientation_wxyz", fmt::format("norm is {}, not 1", quat.norm()));
-      else
-        T.linear() = quat.toRotationMatrix();
-    }
-  } else if (r.has("rotation_rpy_deg")) {
-    const Vec3 rpy = r.vec3("rotation_rpy_deg") * std::numbers::pi / 180;
-    T.linear() = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
-                  Eigen::AngleAxisd(rpy.x(), Vec3::UnitX())).toRotationMatrix();
-  }
-  return T;
 }
 
 SceneTransform read_transform(TableReader& r) {

@@ -1,10 +1,13 @@
 #pragma once
 // Options of the AprilTag fiducial tracker (type = "fiducial"), read from its
-// [devices.<name>] table and its [[devices.<name>.tags]] tag map.
+// [devices.<name>] table, its [[devices.<name>.tags]] tag map and its
+// [[devices.<name>.bundles]] tag bundles.
 #include <map>
 #include <string>
+#include <vector>
 
 #include "covtrack/devices/config_reader.hpp"
+#include "covtrack/devices/fiducial/bundle_pose.hpp"
 #include "covtrack/devices/fiducial/corner_noise.hpp"
 #include "covtrack/devices/fiducial/tag_detector.hpp"
 
@@ -25,12 +28,21 @@ struct FiducialConfig {
   int image_every_n = 1;        // one image per this many frames
   int image_jpeg_quality = 80;
   std::map<int, double> tag_size_m;  // the tag map: id -> edge of the detected square
+  std::vector<TagBundle> bundles;     // a tag is in one bundle at most, and then not in the map
+  double bundle_consistency_chi2 = 40;
 };
 
 const TableSpec& fiducial_device_spec();
 const TableSpec& fiducial_tag_spec();
+const TableSpec& fiducial_bundle_spec();
+const TableSpec& fiducial_bundle_tag_spec();
 
 // Relative paths are taken from the config file's folder. Problems go to the reader.
 FiducialConfig read_fiducial_config(TableReader& device, const std::string& device_name);
+
+// The tag bundles of every fiducial device in a covtrackd config file (for tools that
+// render or calibrate a bundle as the daemon will see it); every problem of those
+// devices' tables in one error.
+Result<std::vector<TagBundle>> read_config_bundles(const std::string& config_file);
 
 }  // namespace covtrack::fiducial

@@ -1,7 +1,8 @@
 #pragma once
 // The AprilTag fiducial tracker: frames from a camera, a video or an image sequence;
-// per mapped tag a pose T_camera_tag (sensor "tag<id>") with its covariance; the raw
-// detections on covtrack/raw/<device>.
+// per mapped tag a pose T_camera_tag (sensor "tag<id>") with its covariance, per tag
+// bundle one pose T_camera_bundle (sensor: the bundle's name) from all its tags in view;
+// the raw detections on covtrack/raw/<device>.
 #include <memory>
 
 #include "covtrack/devices/driver.hpp"

@@ -42,7 +42,19 @@ struct TagPose {
   double corner_sigma_px = 0;
   double ambiguity_chi2 = 0;       // the two poses' corners' Mahalanobis^2; inf without second
   bool ambiguous = false;          // the covariance was inflated to cover the second pose
+  // What the pose was fitted to: the corners corrected for the predicted edge shifts and
+  // the lens, undistorted (pinhole pixels), and their full covariance (a bundle's pose
+  // stacks these of its tags).
+  std::array<cv::Point2d, 4> corners_px{};
+  Eigen::Matrix<double, 8, 8> corner_covariance = Eigen::Matrix<double, 8, 8>::Zero();
 };
+
+// The tag's corners in its own frame, in the detector's order (AprilTag 3's).
+std::array<Vec3, 4> tag_corner_points(double size_m);
+
+// d(pixel)/d(xi) of the point X (in the frame of T_camera_frame) under the pinhole
+// projection, for the BODY perturbation T_camera_frame * Exp(xi).
+Eigen::Matrix<double, 2, 6> point_jacobian(const CameraModel& camera, const Pose& T_camera_frame, const Vec3& X);
 
 // d(corner pixels)/d(xi) at T_camera_tag, rows u0 v0 u1 v1 ..., pinhole projection.
 CornerJacobian corner_jacobian(const CameraModel& camera, const Pose& T_camera_tag, double size_m);

@@ -1,0 +1,268 @@
+#include "covtrack/devices/fiducial/bundle_pose.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+namespace covtrack::fiducial {
+namespace {
+
+using Vec8 = Eigen::Matrix<double, 8, 1>;
+using Mat8 = Eigen::Matrix<double, 8, 8>;
+
+// One tag's corners as the bundle's fit sees them: where they are on the bundle, where
+// they were measured, and the whitening W (W^T W = Sigma^-1) of their covariance.
+struct TagCorners {
+  std::array<Vec3, 4> X_bundle;
+  Vec8 measured;
+  Mat8 whiten;
+};
+
+struct Fit {
+  Pose T = Pose::Identity();
+  Mat6 covariance = Mat6::Zero();
+  double cost = std::numeric_limits<double>::infinity();  // sum of squared whitened residuals
+};
+
+Result<TagCorners> corners_of(const BundleObservation& o) {
+  TagCorners t;
+  const auto X = tag_corner_points(o.tag.size_m);
+  for (int k = 0; k < 4; ++k) {
+    t.X_bundle[k] = o.tag.T_bundle_tag * X[k];
+    t.measured(2 * k) = o.pose.corners_px[k].x, t.measured(2 * k + 1) = o.pose.corners_px[k].y;
+  }
+  const Eigen::LLT<Mat8> llt(o.pose.corner_covariance);
+  if (llt.info() != Eigen::Success) return fail(fmt::format("tag {}: corner covariance is not positive definite", o.tag.id));
+  t.whiten = llt.matrixL().solve(Mat8::Identity());
+  return t;
+}
+
+// Whitened residuals of the tags' corners at T; false when a corner is behind the camera.
+bool residuals(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T, Eigen::VectorXd& r) {
+  r.resize(8 * static_cast<Eigen::Index>(tags.size()));
+  for (std::size_t i = 0; i < tags.size(); ++i) {
+    Vec8 d;
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 p = T * tags[i].X_bundle[k];
+      if (!(p.z() > 0)) return false;
+      const cv::Point2d u = cam.project(p);
+      d(2 * k) = tags[i].measured(2 * k) - u.x, d(2 * k + 1) = tags[i].measured(2 * k + 1) - u.y;
+    }
+    r.segment<8>(8 * static_cast<Eigen::Index>(i)) = tags[i].whiten * d;
+  }
+  return true;
+}
+
+double cost_at(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T) {
+  Eigen::VectorXd r;
+  return residuals(cam, tags, T, r) ? r.squaredNorm() : std::numeric_limits<double>::infinity();
+}
+
+// J^T Sigma^-1 J at T (the information of the BODY perturbation) and J^T Sigma^-1 r.
+void normal_equations(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T, Mat6& H, Vec6& g) {
+  H.setZero(), g.setZero();
+  Eigen::VectorXd r;
+  residuals(cam, tags, T, r);
+  for (std::size_t i = 0; i < tags.size(); ++i) {
+    Eigen::Matrix<double, 8, 6> J;
+    for (int k = 0; k < 4; ++k) J.block<2, 6>(2 * k, 0) = point_jacobian(cam, T, tags[i].X_bundle[k]);
+    const Eigen::Matrix<double, 8, 6> Jw = tags[i].whiten * J;
+    H += Jw.transpose() * Jw;
+    g += Jw.transpose() * r.segment<8>(8 * static_cast<Eigen::Index>(i));
+  }
+}
+
+// Gauss-Newton from T0, halving a step that does not lower the cost.
+Fit gauss_newton(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T0) {
+  Fit f{T0, Mat6::Zero(), cost_at(cam, tags, T0)};
+  if (!std::isfinite(f.cost)) return f;
+  Mat6 H;
+  Vec6 g;
+  for (int iteration = 0; iteration < 30; ++iteration) {
+    normal_equations(cam, tags, f.T, H, g);
+    const Vec6 step = H.ldlt().solve(g);
+    // Done when the step would lower the cost (a chi-square) by less than 1e-6.
+    if (!step.allFinite() || g.dot(step) < 1e-6) break;
+    bool lowered = false;
+    for (double scale = 1; scale > 1e-3 && !lowered; scale /= 2) {
+      const Pose T = boxplus(f.T, scale * step);
+      const double c = cost_at(cam, tags, T);
+      if (c < f.cost) f.T = T, f.cost = c, lowered = true;
+    }
+    if (!lowered) break;
+  }
+  normal_equations(cam, tags, f.T, H, g);
+  f.covariance = H.ldlt().solve(Mat6::Identity());
+  f.covariance = (f.covariance + f.covariance.transpose()) / 2;
+  return f;
+}
+
+// The part of a symmetric matrix with non-negative eigenvalues.
+Mat6 positive_part(const Mat6& m) {
+  const Eigen::SelfAdjointEigenSolver<Mat6> eig((m + m.transpose()) / 2);
+  return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0).asDiagonal() * eig.eigenvectors().transpose();
+}
+
+// The bundle is this one tag's pose, mapped: T_camera_tag Exp(xi_tag) T_bundle_tag^-1 =
+// T_camera_bundle Exp(Ad(T_bundle_tag) xi_tag).
+BundlePose from_one_tag(const BundleObservation& o) {
+  BundlePose b;
+  const Mat6 A = se3_adjoint(o.tag.T_bundle_tag);
+  b.T_camera_bundle = o.pose.best.T_camera_tag * o.tag.T_bundle_tag.inverse();
+  b.covariance = A * o.pose.covariance * A.transpose();
+  b.ids = {o.tag.id};
+  b.ambiguous = o.pose.ambiguous;
+  b.ambiguity_chi2 = o.pose.ambiguity_chi2;
+  if (b.ambiguous)
+    b.why_degraded = fmt::format("ambiguous: only tag {} in view, and its second pose fits within chi2 {:.1f}",
+                                 o.tag.id, b.ambiguity_chi2);
+  return b;
+}
+
+// Corner-space chi2 between two poses: how well the data tells them apart.
+double separation_chi2(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& a, const Pose& b) {
+  Eigen::VectorXd ra, rb;
+  if (!residuals(cam, tags, a, ra) || !residuals(cam, tags, b, rb)) return std::numeric_limits<double>::infinity();
+  return (ra - rb).squaredNorm();  // the measured corners cancel
+}
+
+// A tag's own pose against the pose the other tags give it. Its best solution is the one
+// compared, or its second when only that one agrees: the others then resolved its flip.
+TagAgreement agreement_of(const CameraModel& cam, const BundleObservation& o, const Fit& others, double limit) {
+  const Pose T_predicted = others.T * o.tag.T_bundle_tag;
+  const Mat6 A = se3_adjoint(o.tag.T_bundle_tag.inverse());
+  const Mat6 C_predicted = A * others.covariance * A.transpose();
+  const auto compare = [&](const PoseSolution& s) {
+    // The tag's own covariance at this solution, before any ambiguity inflation (which
+    // covers the other solution, compared on its own here).
+    const Mat6 C_tag =
+        pose_covariance(corner_jacobian(cam, s.T_camera_tag, o.tag.size_m), o.pose.corner_covariance);
+    const Vec6 e = boxminus(s.T_camera_tag, T_predicted);
+    return TagAgreement{o.tag.id, e.dot((C_tag + C_predicted).ldlt().solve(e)),
+                        (s.T_camera_tag.translation() - T_predicted.translation()).norm(),
+                        so3_log(T_predicted.rotation().transpose() * s.T_camera_tag.rotation()).norm()};
+  };
+  const TagAgreement best = compare(o.pose.best);
+  if (best.chi2 <= limit || !o.pose.second) return best;
+  const TagAgreement second = compare(*o.pose.second);
+  return second.chi2 <= limit ? second : best;
+}
+
+std::string describe(const TagAgreement& a, double limit) {
+  return fmt::format("tag {} is {:.1f} mm and {:.2f} deg from where the other tags put it (chi2 {:.1f} on 6 dof, "
+                     "limit {:.1f})",
+                     a.id, a.offset_m * 1e3, a.offset_rad * 180 / M_PI, a.chi2, limit);
+}
+
+}  // namespace
+
+Result<BundlePose> estimate_bundle_pose(const CameraModel& cam, const std::vector<BundleObservation>& observations,
+                                        double ambiguity_chi2, double consistency_chi2) {
+  if (observations.empty()) return fail("no tag of the bundle in view");
+  if (observations.size() == 1) return from_one_tag(observations[0]);
+  std::vector<TagCorners> tags;
+  for (const auto& o : observations) {
+    auto t = corners_of(o);
+    if (!t) return std::unexpected(t.error());
+    tags.push_back(*t);
+  }
+
+  // Starts: both solutions of every tag, mapped to the bundle, lowest cost first. A start
+  // near a minimum already found would only find it again (0.01: 0.6 degrees or 1 cm, far
+  // below a flip and far above the noise).
+  std::vector<std::pair<double, Pose>> starts;
+  for (const auto& o : observations) {
+    const Pose T_tag_bundle = o.tag.T_bundle_tag.inverse();
+    for (const auto* s : {&o.pose.best, o.pose.second ? &*o.pose.second : nullptr})
+      if (s) starts.emplace_back(cost_at(cam, tags, s->T_camera_tag * T_tag_bundle), s->T_camera_tag * T_tag_bundle);
+  }
+  std::sort(starts.begin(), starts.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Fit> fits;
+  for (const auto& [cost, T] : starts)
+    if (std::none_of(fits.begin(), fits.end(), [&](const Fit& f) { return boxminus(T, f.T).norm() < 0.01; }))
+      fits.push_back(gauss_newton(cam, tags, T));
+  std::sort(fits.begin(), fits.end(), [](const Fit& a, const Fit& b) { return a.cost < b.cost; });
+  const Fit& best = fits.front();
+  if (!std::isfinite(best.cost) || !best.covariance.allFinite())
+    return fail("no bundle pose puts its tags in front of the camera");
+
+  BundlePose out;
+  std::vector<std::string> why;
+
+  // A second minimum the corners cannot tell from the best: cover it.
+  out.ambiguity_chi2 = std::numeric_limits<double>::infinity();
+  const Fit* second = nullptr;
+  for (std::size_t i = 1; i < fits.size(); ++i) {
+    const Vec6 s = boxminus(fits[i].T, best.T);
+    if (!std::isfinite(fits[i].cost) || s.dot(best.covariance.ldlt().solve(s)) < 1) continue;  // the same minimum
+    const double chi2 = separation_chi2(cam, tags, fits[i].T, best.T);
+    if (chi2 < out.ambiguity_chi2) out.ambiguity_chi2 = chi2, second = &fits[i];
+  }
+  if (second && out.ambiguity_chi2 < ambiguity_chi2) {
+    out.ambiguous = true;
+    why.push_back(fmt::format("ambiguous: a second pose fits within chi2 {:.1f}", out.ambiguity_chi2));
+  }
+
+  // Each tag against the others. While a strict majority of the tags in view would still
+  // agree without it, the worst tag above the limit is left out and the rest refitted;
+  // when none can be left out (two tags, or no majority), the covariance grows to cover
+  // the pose the others give without each disagreeing tag.
+  std::vector<std::size_t> members(observations.size());
+  for (std::size_t i = 0; i < members.size(); ++i) members[i] = i;
+  Fit fit = best;
+  std::vector<TagAgreement> agreement, left_out;
+  std::vector<Fit> without;  // per member: the fit of the other members
+  for (;;) {
+    agreement.clear(), without.clear();
+    for (std::size_t m = 0; m < members.size(); ++m) {
+      std::vector<TagCorners> others;
+      for (std::size_t k = 0; k < members.size(); ++k)
+        if (k != m) others.push_back(tags[members[k]]);
+      without.push_back(gauss_newton(cam, others, fit.T));
+      agreement.push_back(agreement_of(cam, observations[members[m]], without.back(), consistency_chi2));
+    }
+    const auto worst = static_cast<std::size_t>(
+        std::max_element(agreement.begin(), agreement.end(),
+                         [](const TagAgreement& a, const TagAgreement& b) { return a.chi2 < b.chi2; }) -
+        agreement.begin());
+    const bool majority_without_it = members.size() > 2 && 2 * (members.size() - 1) > observations.size();
+    if (!(agreement[worst].chi2 > consistency_chi2) || !majority_without_it) break;
+    left_out.push_back(agreement[worst]);
+    fit = without[worst];
+    members.erase(members.begin() + static_cast<std::ptrdiff_t>(worst));
+  }
+  for (const TagAgreement& a : left_out) why.push_back(fmt::format("left out {}", describe(a, consistency_chi2)));
+  out.T_camera_bundle = fit.T;
+  out.covariance = fit.covariance;
+  std::vector<std::string> disagreeing;
+  for (std::size_t m = 0; m < members.size(); ++m) {
+    if (!(agreement[m].chi2 > consistency_chi2)) continue;
+    const Vec6 d = boxminus(without[m].T, fit.T);
+    out.covariance += positive_part(without[m].covariance - fit.covariance) + d * d.transpose();
+    disagreeing.push_back(describe(agreement[m], consistency_chi2));
+  }
+  if (!disagreeing.empty())
+    why.push_back(fmt::format("no majority of the tags agrees, so the covariance covers each: {}",
+                              fmt::join(disagreeing, "; ")));
+  out.disagree = !left_out.empty() || !disagreeing.empty();
+  if (out.ambiguous) {
+    const Vec6 s = boxminus(second->T, fit.T);
+    out.covariance += s * s.transpose();
+  }
+  for (std::size_t m : members) out.ids.push_back(observations[m].tag.id);
+  for (const TagAgreement& a : left_out) out.left_out.push_back(a.id);
+  out.agreement = agreement;
+  out.agreement.insert(out.agreement.end(), left_out.begin(), left_out.end());
+  std::sort(out.agreement.begin(), out.agreement.end(),
+            [](const TagAgreement& a, const TagAgreement& b) { return a.chi2 > b.chi2; });
+  out.covariance = (out.covariance + out.covariance.transpose()) / 2;
+  out.why_degraded = fmt::format("{}", fmt::join(why, "; "));
+  return out;
+}
+
+}  // namespace covtrack::fiducial

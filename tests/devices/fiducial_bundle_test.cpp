@@ -1,0 +1,313 @@
+// Tag bundles: one pose for a rigid set of tags from all their corners.
+//  - The maths alone: corners drawn from exactly the covariance the model states give a
+//    bundle NEES of chi-square(6), and tags that agree at the limit's rate.
+//  - On renders from the held-out side of the corner model's calibration (the analytic
+//    rasteriser, an 800x600 camera, the validation families), with tags smaller than the
+//    calibration's and shapes it never saw (a flat board of six tags of two sizes, a tent
+//    of four tags on two panels at +-30 degrees): the bundle's NEES against its true pose,
+//    its precision against its best single tag, and how rarely consistent bundles are
+//    called DEGRADED. Each frame is one random camera of the calibration's population, so
+//    frames are independent draws of the systematic corner errors.
+//  - A board whose tag sits 2 cm from where its config says: DEGRADED, the tag named and
+//    left out, the truth inside the 99% region.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <random>
+
+#include "covtrack/devices/fiducial/bundle_pose.hpp"
+#include "covtrack/devices/fiducial/corner_noise.hpp"
+#include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "fiducial_scene.hpp"
+
+using namespace covtrack;
+using namespace covtrack::fiducial;
+
+namespace {
+
+constexpr double kChi2_6_99 = 16.812;
+
+// The detected square of a tag printed `printed_m` wide (for some families the printed tag
+// reaches well beyond the square the detector finds: tagCircle49h12's is 5 of 11 cells).
+double detected_size(const TagFamily& family, double printed_m) {
+  return printed_m * family.cells_across_border() / family.cells_across_total();
+}
+
+// Six tags printed 0.065 and 0.055 m wide on a flat board, 0.08 m apart.
+std::vector<BundleTag> board(const TagFamily& family) {
+  std::vector<BundleTag> tags;
+  for (int id = 0; id < 6; ++id) {
+    Pose T = Pose::Identity();
+    T.translation() = Vec3((id % 3 - 1) * 0.08, (id / 3 - 0.5) * 0.08, 0);
+    tags.push_back({id, detected_size(family, id % 2 ? 0.055 : 0.065), T});
+  }
+  return tags;
+}
+
+// A tent: two panels meeting in a ridge along the bundle's y axis, towards the camera,
+// each turned 30 degrees away; two tags printed 0.06 m wide per panel.
+std::vector<BundleTag> tent(const TagFamily& family) {
+  std::vector<BundleTag> tags;
+  const double angle = 30 * M_PI / 180, along = 0.05;  // a tag centre's distance from the ridge
+  for (int id = 0; id < 4; ++id) {
+    const double side = id < 2 ? -1 : 1;
+    Pose T = Pose::Identity();
+    T.linear() = Eigen::AngleAxisd(-side * angle, Vec3::UnitY()).toRotationMatrix();
+    T.translation() = Vec3(side * along * std::cos(angle), (id % 2 - 0.5) * 0.075, along * std::sin(angle));
+    tags.push_back({id, detected_size(family, 0.06), T});
+  }
+  return tags;
+}
+
+// A bundle 0.4-0.65 m ahead, turned by up to 30 degrees either way and rolled freely.
+Pose random_bundle_pose(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  return test::tag_pose(0.525 + 0.125 * u(rng), 30 * u(rng), 20 * u(rng), 180 * u(rng), 0.04 * u(rng),
+                        0.03 * u(rng));
+}
+
+double nees(const Pose& truth, const Pose& estimate, const Mat6& covariance) {
+  const Vec6 e = boxminus(truth, estimate);
+  return e.dot(covariance.ldlt().solve(e));
+}
+
+struct FrameResult {
+  bool tent = false;
+  Pose truth;  // T_camera_bundle
+  std::optional<BundlePose> bundle;
+  std::optional<Pose> best_tag;  // the most precise single tag's pose, mapped to the bundle
+  Mat6 best_tag_covariance = Mat6::Zero();
+  std::vector<BundleObservation> seen;  // the bundle's tags as posed on their own
+};
+
+// Renders bundles and poses them as the driver does (detection, corner model, tag poses,
+// bundle), with the shipped defaults throughout.
+class Renderer {
+ public:
+  static constexpr int kFamilies = 4;
+
+  Renderer() {
+    for (const char* family : {"tag25h9", "tagStandard52h13", "tagCircle49h12", "tagCustom48h12"}) {
+      DetectorOptions o;
+      o.family = family;
+      o.decimate = 1;
+      auto d = TagDetector::create(o);
+      EXPECT_TRUE(d.has_value()) << d.error().message;
+      if (d) detectors_.push_back(std::move(*d));
+    }
+  }
+
+  const CameraModel& camera() const { return camera_; }
+  const TagFamily& family(int f) const { return detectors_[static_cast<std::size_t>(f)]->family(); }
+
+  // Renders `rendered` (the tags where they really are on the bundle) at T_camera_bundle in
+  // family `f` and solves the bundle as `configured` says it is.
+  FrameResult frame(int f, const std::vector<BundleTag>& configured, const std::vector<BundleTag>& rendered,
+                    const Pose& T_camera_bundle, std::mt19937_64& rng) {
+    TagDetector& detector = *detectors_[static_cast<std::size_t>(f)];
+    std::vector<RenderedTag> scene;
+    for (const BundleTag& t : rendered) scene.push_back({t.id, t.size_m, T_camera_bundle * t.T_bundle_tag});
+    const ImageFormation formation = test::random_formation(rng, Rasteriser::AnalyticArea);
+    const cv::Mat image = form_image(camera_, detector.family(), scene, formation, rng);
+    const double noise = estimate_image_noise(image);
+    FrameResult out;
+    out.truth = T_camera_bundle;
+    double best_det = std::numeric_limits<double>::infinity();
+    for (const Detection& d : detector.detect(image)) {
+      const auto tag =
+          std::find_if(configured.begin(), configured.end(), [&](const BundleTag& t) { return t.id == d.id; });
+      if (tag == configured.end()) continue;
+      const CornerNoise corner_noise = model_.noise(measure_corner_inputs(image, d, detector.family(), noise));
+      auto pose = estimate_tag_pose(camera_, d.corners_px, tag->size_m, corner_noise);
+      if (!pose) continue;  // a tag cut by the frame's edge is refused
+      out.seen.push_back({*tag, *pose});
+      // The best single tag: the smallest covariance of the pose it gives the bundle.
+      const Mat6 A = se3_adjoint(tag->T_bundle_tag);
+      const Mat6 C = A * pose->covariance * A.transpose();
+      if (C.determinant() < best_det) {
+        best_det = C.determinant();
+        out.best_tag = pose->best.T_camera_tag * tag->T_bundle_tag.inverse();
+        out.best_tag_covariance = C;
+      }
+    }
+    if (!out.seen.empty()) {
+      auto b = estimate_bundle_pose(camera_, out.seen);  // the driver's default limits
+      EXPECT_TRUE(b.has_value()) << b.error().message;
+      if (b) out.bundle = *b;
+    }
+    return out;
+  }
+
+ private:
+  CameraModel camera_ = test::camera(800, 600, 58);
+  CornerNoiseModel model_;
+  std::vector<std::unique_ptr<TagDetector>> detectors_;
+};
+
+// The consistent bundles, rendered once for the tests that judge them: boards and tents in
+// turn, each in every family.
+const std::vector<FrameResult>& consistent_frames() {
+  static const std::vector<FrameResult> frames = [] {
+    Renderer renderer;
+    std::mt19937_64 rng(57);
+    std::vector<FrameResult> out;
+    for (int i = 0; i < 120; ++i) {
+      const bool is_tent = i % 2;
+      const int f = (i / 2) % Renderer::kFamilies;
+      const auto layout = is_tent ? tent(renderer.family(f)) : board(renderer.family(f));
+      out.push_back(renderer.frame(f, layout, layout, random_bundle_pose(rng), rng));
+      out.back().tent = is_tent;
+    }
+    return out;
+  }();
+  return frames;
+}
+
+// The 99% bounds of the mean of n independent chi-square(6) draws.
+std::pair<double, double> mean_bounds(int n) {
+  const double half_width = 2.576 * std::sqrt(12.0 / n);
+  return {6 - half_width, 6 + half_width};
+}
+
+}  // namespace
+
+// Catches a wrong Jacobian, a wrong adjoint, or blocks treated as anything but independent.
+TEST(FiducialBundle, CovarianceIsExactForCornersDrawnFromTheModel) {
+  constexpr double kChi2_6_999 = 22.458;
+  const CameraModel cam = test::camera(800, 600, 58);
+  auto family = TagFamily::open("tag36h11");
+  ASSERT_TRUE(family.has_value());
+  CornerNoise noise;  // systematic terms as large as the defaults give a blurred tag
+  noise.sigma_px = 0.08, noise.scale_sigma_px = 0.1, noise.edge_sigma_px = 0.04, noise.tilt_sigma_px = 0.03;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> gauss;
+  double sum = 0;
+  int n = 0, disagree = 0, tags = 0;
+  for (int draw = 0; draw < 1000; ++draw) {
+    const auto layout = draw % 2 ? tent(**family) : board(**family);
+    const Pose T_camera_bundle = random_bundle_pose(rng);
+    std::vector<BundleObservation> seen;
+    for (const BundleTag& t : layout) {
+      const auto X = tag_corner_points(t.size_m);
+      std::array<cv::Point2d, 4> corners;
+      for (int k = 0; k < 4; ++k) corners[k] = cam.project(T_camera_bundle * t.T_bundle_tag * X[k]);
+      const Eigen::Matrix<double, 8, 8> L = corner_covariance(corners, noise).llt().matrixL();
+      Eigen::Matrix<double, 8, 1> z;
+      for (int i = 0; i < 8; ++i) z(i) = gauss(rng);
+      const Eigen::Matrix<double, 8, 1> e = L * z;
+      for (int k = 0; k < 4; ++k) corners[k] += cv::Point2d(e(2 * k), e(2 * k + 1));
+      auto pose = estimate_tag_pose(cam, corners, t.size_m, noise);
+      if (pose) seen.push_back({t, *pose});  // else too near the frame's edge
+    }
+    if (seen.size() < 2) continue;
+    auto b = estimate_bundle_pose(cam, seen, 40, kChi2_6_999);
+    ASSERT_TRUE(b.has_value()) << b.error().message;
+    sum += nees(T_camera_bundle, b->T_camera_bundle, b->covariance), ++n;
+    disagree += b->disagree, tags += static_cast<int>(seen.size());
+  }
+  const auto [lo, hi] = mean_bounds(n);
+  std::printf("corners drawn from the model: bundle NEES %.3f over %d draws (99%% bounds [%.3f, %.3f]); %d of %d "
+              "tags disagree at chi-square(6)'s 99.9%% quantile\n",
+              sum / n, n, lo, hi, disagree, tags);
+  EXPECT_GE(n, 950);
+  EXPECT_GT(sum / n, lo);
+  EXPECT_LT(sum / n, hi);
+  EXPECT_LE(disagree, 3 * tags / 1000 + 3) << "about 1 in 1000 tags should disagree";
+}
+
+TEST(FiducialBundle, NeesOfTheBundlePoseOnHeldOutRenders) {
+  const auto& frames = consistent_frames();
+  double sum[2] = {0, 0};
+  int n[2] = {0, 0}, degraded = 0, outside = 0, tags = 0;
+  for (const FrameResult& f : frames) {
+    if (!f.bundle || f.bundle->ids.size() + f.bundle->left_out.size() < 2) continue;
+    const double v = nees(f.truth, f.bundle->T_camera_bundle, f.bundle->covariance);
+    sum[f.tent] += v, ++n[f.tent], outside += v > kChi2_6_99;
+    tags += static_cast<int>(f.seen.size());
+    degraded += f.bundle->degraded();
+    if (f.bundle->degraded()) std::printf("DEGRADED (%s): %s\n", f.tent ? "tent" : "board", f.bundle->why_degraded.c_str());
+  }
+  const int all = n[0] + n[1];
+  const auto [lo, hi] = mean_bounds(all);
+  const auto [tent_lo, tent_hi] = mean_bounds(n[1]);
+  const auto [board_lo, board_hi] = mean_bounds(n[0]);
+  std::printf("bundle NEES: all %.2f over %d frames ([%.2f, %.2f]), %.1f tags each; boards %.2f over %d "
+              "([%.2f, %.2f]); tents %.2f over %d ([%.2f, %.2f]); truth outside the 99%% region %d; DEGRADED %d\n",
+              (sum[0] + sum[1]) / all, all, lo, hi, double(tags) / all, sum[0] / n[0], n[0], board_lo, board_hi,
+              sum[1] / n[1], n[1], tent_lo, tent_hi, outside, degraded);
+  EXPECT_GE(all, static_cast<int>(frames.size()) * 9 / 10) << "too few bundles posed";
+  // Never over-confident: every mean below chi-square(6)'s upper 99% bound.
+  EXPECT_LT((sum[0] + sum[1]) / all, hi);
+  EXPECT_LT(sum[0] / n[0], board_hi);
+  EXPECT_LT(sum[1] / n[1], tent_hi);
+  // The tents (a non-planar object) within both bounds.
+  EXPECT_GT(sum[1] / n[1], tent_lo);
+  // The boards are under-confident, about 2x (measured 3.1): the corner model's per-edge
+  // terms are larger than these renders' errors and its turn terms smaller, which a single
+  // tag's pose, dominated by its apparent size, does not show (devices/fiducial/README.md,
+  // "Tag bundles"). This bounds it at 2.5x.
+  EXPECT_GT(sum[0] / n[0], 6 / 2.5);
+  // Consistent tags are rarely called inconsistent at the default limit.
+  EXPECT_LE(degraded * 100, all * 5) << "consistent bundles DEGRADED";
+}
+
+TEST(FiducialBundle, IsMorePreciseThanItsBestSingleTag) {
+  double bundle_sq = 0, tag_sq = 0, bundle_rot_sq = 0, tag_rot_sq = 0, sigma_ratio = 0;
+  int n = 0;
+  for (const FrameResult& f : consistent_frames()) {
+    if (!f.bundle || f.bundle->ids.size() < 2) continue;
+    const Vec6 eb = boxminus(f.truth, f.bundle->T_camera_bundle), et = boxminus(f.truth, *f.best_tag);
+    bundle_sq += eb.head<3>().squaredNorm(), tag_sq += et.head<3>().squaredNorm();
+    bundle_rot_sq += eb.tail<3>().squaredNorm(), tag_rot_sq += et.tail<3>().squaredNorm();
+    sigma_ratio += std::sqrt(f.bundle->covariance.topLeftCorner<3, 3>().trace() /
+                             f.best_tag_covariance.topLeftCorner<3, 3>().trace());
+    ++n;
+  }
+  ASSERT_GT(n, 0);
+  const double position_ratio = std::sqrt(bundle_sq / tag_sq), rotation_ratio = std::sqrt(bundle_rot_sq / tag_rot_sq);
+  std::printf("RMS error at the bundle's origin, bundle / best single tag: position %.2f / %.2f mm (%.2f), "
+              "rotation %.3f / %.3f deg (%.2f); reported position sigma %.2f of the tag's (mean over %d frames)\n",
+              std::sqrt(bundle_sq / n) * 1e3, std::sqrt(tag_sq / n) * 1e3, position_ratio,
+              std::sqrt(bundle_rot_sq / n) * 180 / M_PI, std::sqrt(tag_rot_sq / n) * 180 / M_PI, rotation_ratio,
+              sigma_ratio / n, n);
+  EXPECT_LT(position_ratio, 0.5);
+  EXPECT_LT(rotation_ratio, 0.5);
+  EXPECT_LT(sigma_ratio / n, 0.5);
+}
+
+TEST(FiducialBundle, ATagMovedOnTheBoardIsFoundLeftOutAndCovered) {
+  constexpr int kMoved = 4, kFrames = 32;
+  Renderer renderer;
+  std::mt19937_64 rng(61);
+  int n = 0, degraded = 0, named = 0, inside = 0, inside_plain = 0;
+  for (int i = 0; i < kFrames; ++i) {
+    const int f = i % Renderer::kFamilies;
+    const auto configured = board(renderer.family(f));
+    auto rendered = configured;
+    rendered[kMoved].T_bundle_tag.translation() += Vec3(0, 0.02, 0);  // 2 cm along the board, outward
+    const FrameResult r = renderer.frame(f, configured, rendered, random_bundle_pose(rng), rng);
+    if (!r.bundle || r.seen.size() < 3) continue;
+    ++n;
+    degraded += r.bundle->disagree;
+    named += r.bundle->left_out == std::vector<int>{kMoved} &&
+             r.bundle->why_degraded.find("tag 4 is") != std::string::npos;
+    inside += nees(r.truth, r.bundle->T_camera_bundle, r.bundle->covariance) <= kChi2_6_99;
+    // All tags fitted together, with no limit: the moved tag pulls the pose off.
+    const auto plain = estimate_bundle_pose(renderer.camera(), r.seen, 40, std::numeric_limits<double>::infinity());
+    ASSERT_TRUE(plain.has_value());
+    inside_plain += nees(r.truth, plain->T_camera_bundle, plain->covariance) <= kChi2_6_99;
+    if (i < 2) std::printf("frame %d: %s\n", i, r.bundle->why_degraded.c_str());
+  }
+  std::printf("tag %d moved 2 cm: %d frames, DEGRADED %d, tag %d alone left out and named %d, truth inside the 99%% "
+              "region %d (all tags fitted together: %d)\n",
+              kMoved, n, degraded, kMoved, named, inside, inside_plain);
+  EXPECT_GE(n, kFrames * 9 / 10);
+  EXPECT_EQ(degraded, n);
+  EXPECT_GE(named, n * 9 / 10);
+  EXPECT_GE(inside, n * 95 / 100);
+  EXPECT_LT(inside_plain, n / 2) << "the moved tag must matter, or this test shows nothing";
+}
