@@ -50,7 +50,7 @@ const std::vector<DriverType>& driver_types() {
       {"fiducial", "AprilTag fiducial tracker: tag poses from a camera, video or image sequence, "
        "covariance from a calibrated corner noise model",
        {&fiducial::fiducial_device_spec(), &fiducial::fiducial_tag_spec(), &fiducial::fiducial_bundle_spec(),
-        &fiducial::fiducial_bundle_tag_spec()},
+        &fiducial::fiducial_bundle_tag_spec(), &fiducial::corner_calibration_spec()},
        [](TableReader& device, const std::string& name) -> DriverFactory {
          fiducial::FiducialConfig config = fiducial::read_fiducial_config(device, name);
          return [config](std::uint64_t run) { return fiducial::make_fiducial_driver(config, run); };

@@ -265,4 +265,22 @@ Result<BundlePose> estimate_bundle_pose(const CameraModel& cam, const std::vecto
   return out;
 }
 
+Result<BundlePose> refine_bundle_pose(const CameraModel& cam, const std::vector<BundleObservation>& observations,
+                                      const Pose& start) {
+  std::vector<TagCorners> tags;
+  for (const auto& o : observations) {
+    auto t = corners_of(o);
+    if (!t) return std::unexpected(t.error());
+    tags.push_back(*t);
+  }
+  const Fit fit = gauss_newton(cam, tags, start);
+  if (!std::isfinite(fit.cost) || !fit.covariance.allFinite()) return fail("no bundle pose near the start fits");
+  BundlePose out;
+  out.T_camera_bundle = fit.T;
+  out.covariance = fit.covariance;
+  for (const auto& o : observations) out.ids.push_back(o.tag.id);
+  out.ambiguity_chi2 = std::numeric_limits<double>::infinity();
+  return out;
+}
+
 }  // namespace covtrack::fiducial

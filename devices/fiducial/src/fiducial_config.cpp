@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "covtrack/devices/device_keys.hpp"
 #include "covtrack/devices/fiducial/frame_source.hpp"
@@ -26,6 +27,41 @@ const TableSpec& fiducial_device_spec() {
         {"quad_sigma", ValueType::Float, "px", "0", "blur before the quad search (0.8 speeds up "
          "noisy frames)", 0, 10},
         {"threads", ValueType::Integer, "", "1", "detector threads", 1, 64},
+        {"corner_calibration", ValueType::String, "", "none", "this camera's corner noise model: a file "
+         "written by `covtrack calibrate-fiducial` (the corner_* keys in its [corner_model] table); "
+         "relative to this file; corner_* keys may not be given here as well"},
+        {"ambiguity_chi2", ValueType::Float, "", "40", "inflate the covariance to cover the second "
+         "pose when it fits within this many corner variances", 0, 1e6},
+        {"rate_hz", ValueType::Float, "Hz", "30", "files: frames per second (0: as fast as "
+         "possible); cameras run at their own rate", 0, 10000},
+        {"loop", ValueType::Boolean, "", "true", "files: start over at the end"},
+        {"publish_raw", ValueType::Boolean, "", "true", "publish detections on covtrack/raw/<name> "
+         "(format: devices/fiducial/README.md)"},
+        {"publish_images", ValueType::Boolean, "", "false", "publish the frames detected on, as JPEG, on "
+         "covtrack/image/<name> with their poses' measurement time (a recorded session then shows "
+         "the camera's picture in `covtrack view --log`)"},
+        {"image_every_n", ValueType::Integer, "", "1", "publish_images: one image per this many "
+         "frames", 1, 10000},
+        {"image_jpeg_quality", ValueType::Integer, "", "80", "publish_images: JPEG quality (higher: "
+         "larger, sharper)", 1, 100},
+        {"tags", ValueType::TableArray, "", "[]", "the tag map: [[devices.<name>.tags]], each tag a "
+         "sensor of its own; tags neither here nor in a bundle are ignored"},
+        {"bundles", ValueType::TableArray, "", "[]", "tag bundles: [[devices.<name>.bundles]], each a "
+         "rigid set of tags posed as one sensor from all their corners (devices/fiducial/README.md)"},
+        {"bundle_consistency_chi2", ValueType::Float, "", "40", "a bundle's tag whose own pose is further "
+         "than this chi-square (6 dof) from where its other tags put it disagrees: it is left out (or, "
+         "without a majority, covered) and the bundle is DEGRADED", 0, 1e12},
+    };
+    s.keys.insert(s.keys.end(), own.begin(), own.end());
+    const auto corner = corner_model_keys();
+    s.keys.insert(s.keys.end(), corner.begin(), corner.end());
+    return s;
+  }();
+  return spec;
+}
+
+std::vector<KeySpec> corner_model_keys() {
+  return {
         {"corner_gain_px", ValueType::Float, "px", "1.1673", "corner noise model: noise/contrast gain "
          "(devices/fiducial/README.md)", 0, 100},
         {"corner_floor_px", ValueType::Float, "px", "0.0436", "corner noise model: per-camera floor", 0, 100},
@@ -52,31 +88,11 @@ const TableSpec& fiducial_device_spec() {
          "each edge's own turn (its ends' opposite outward errors), floor", 0, 100},
         {"corner_tilt_per_blur", ValueType::Float, "", "0", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},
-        {"ambiguity_chi2", ValueType::Float, "", "40", "inflate the covariance to cover the second "
-         "pose when it fits within this many corner variances", 0, 1e6},
-        {"rate_hz", ValueType::Float, "Hz", "30", "files: frames per second (0: as fast as "
-         "possible); cameras run at their own rate", 0, 10000},
-        {"loop", ValueType::Boolean, "", "true", "files: start over at the end"},
-        {"publish_raw", ValueType::Boolean, "", "true", "publish detections on covtrack/raw/<name> "
-         "(format: devices/fiducial/README.md)"},
-        {"publish_images", ValueType::Boolean, "", "false", "publish the frames detected on, as JPEG, on "
-         "covtrack/image/<name> with their poses' measurement time (a recorded session then shows "
-         "the camera's picture in `covtrack view --log`)"},
-        {"image_every_n", ValueType::Integer, "", "1", "publish_images: one image per this many "
-         "frames", 1, 10000},
-        {"image_jpeg_quality", ValueType::Integer, "", "80", "publish_images: JPEG quality (higher: "
-         "larger, sharper)", 1, 100},
-        {"tags", ValueType::TableArray, "", "[]", "the tag map: [[devices.<name>.tags]], each tag a "
-         "sensor of its own; tags neither here nor in a bundle are ignored"},
-        {"bundles", ValueType::TableArray, "", "[]", "tag bundles: [[devices.<name>.bundles]], each a "
-         "rigid set of tags posed as one sensor from all their corners (devices/fiducial/README.md)"},
-        {"bundle_consistency_chi2", ValueType::Float, "", "40", "a bundle's tag whose own pose is further "
-         "than this chi-square (6 dof) from where its other tags put it disagrees: it is left out (or, "
-         "without a majority, covered) and the bundle is DEGRADED", 0, 1e12},
-    };
-    s.keys.insert(s.keys.end(), own.begin(), own.end());
-    return s;
-  }();
+  };
+}
+
+const TableSpec& corner_calibration_spec() {
+  static const TableSpec spec{"corner_model (a corner_calibration file)", "fiducial driver", corner_model_keys()};
   return spec;
 }
 
@@ -127,6 +143,26 @@ namespace {
 std::string relative_to_config(const std::string& path, const std::string& config_file) {
   if (path.empty() || std::filesystem::path(path).is_absolute()) return path;
   return (std::filesystem::path(config_file).parent_path() / path).string();
+}
+
+// The corner_* keys of `r`, each defaulting to `m`'s value.
+CornerNoiseModel read_corner_model_keys(TableReader& r, CornerNoiseModel m) {
+  m.gain_px = r.number("corner_gain_px", m.gain_px);
+  m.floor_px = r.number("corner_floor_px", m.floor_px);
+  m.aligned_px = r.number("corner_aligned_px", m.aligned_px);
+  m.shift_px = r.number("corner_shift_px", m.shift_px);
+  m.shift_falloff = r.number("corner_shift_falloff", m.shift_falloff);
+  m.shift_sigma_px = r.number("corner_shift_sigma_px", m.shift_sigma_px);
+  m.scale_bias_per_blur = r.number("corner_scale_bias_per_blur", m.scale_bias_per_blur);
+  m.scale_sigma_px = r.number("corner_scale_sigma_px", m.scale_sigma_px);
+  m.scale_per_blur = r.number("corner_scale_per_blur", m.scale_per_blur);
+  m.edge_sigma_px = r.number("corner_edge_sigma_px", m.edge_sigma_px);
+  m.edge_per_blur = r.number("corner_edge_per_blur", m.edge_per_blur);
+  m.tilt_sigma_px = r.number("corner_tilt_sigma_px", m.tilt_sigma_px);
+  m.tilt_per_blur = r.number("corner_tilt_per_blur", m.tilt_per_blur);
+  if (m.floor_px <= 0 && m.gain_px <= 0)
+    r.error("corner_floor_px", "the corner noise model needs a floor or a gain above zero");
+  return m;
 }
 
 // Who claims a tag id: the tag map, or a bundle (by its name, which cannot be this).
@@ -181,21 +217,16 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
   c.detector.decimate = r.number("decimate", 2);
   c.detector.quad_sigma = r.number("quad_sigma", 0);
   c.detector.threads = static_cast<int>(r.integer("threads", 1));
-  c.noise.gain_px = r.number("corner_gain_px", c.noise.gain_px);
-  c.noise.floor_px = r.number("corner_floor_px", c.noise.floor_px);
-  c.noise.aligned_px = r.number("corner_aligned_px", c.noise.aligned_px);
-  c.noise.shift_px = r.number("corner_shift_px", c.noise.shift_px);
-  c.noise.shift_falloff = r.number("corner_shift_falloff", c.noise.shift_falloff);
-  c.noise.shift_sigma_px = r.number("corner_shift_sigma_px", c.noise.shift_sigma_px);
-  c.noise.scale_bias_per_blur = r.number("corner_scale_bias_per_blur", c.noise.scale_bias_per_blur);
-  c.noise.scale_sigma_px = r.number("corner_scale_sigma_px", c.noise.scale_sigma_px);
-  c.noise.scale_per_blur = r.number("corner_scale_per_blur", c.noise.scale_per_blur);
-  c.noise.edge_sigma_px = r.number("corner_edge_sigma_px", c.noise.edge_sigma_px);
-  c.noise.edge_per_blur = r.number("corner_edge_per_blur", c.noise.edge_per_blur);
-  c.noise.tilt_sigma_px = r.number("corner_tilt_sigma_px", c.noise.tilt_sigma_px);
-  c.noise.tilt_per_blur = r.number("corner_tilt_per_blur", c.noise.tilt_per_blur);
-  if (c.noise.floor_px <= 0 && c.noise.gain_px <= 0)
-    r.error("corner_floor_px", "the corner noise model needs a floor or a gain above zero");
+  c.noise = read_corner_model_keys(r, c.noise);
+  c.corner_calibration = relative_to_config(r.string("corner_calibration"), r.file());
+  if (!c.corner_calibration.empty()) {
+    for (const KeySpec& k : corner_model_keys())
+      if (r.has(k.key))
+        r.error(k.key, fmt::format("is given here and by corner_calibration '{}': give the corner model once",
+                                    c.corner_calibration));
+    if (auto model = read_corner_calibration(c.corner_calibration)) c.noise = *model;
+    else r.error("corner_calibration", model.error().message);
+  }
   c.ambiguity_chi2 = r.number("ambiguity_chi2", c.ambiguity_chi2);
   c.rate_hz = r.number("rate_hz", 30);
   c.loop = r.boolean("loop", true);
@@ -232,13 +263,30 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
   return c;
 }
 
-Result<std::vector<TagBundle>> read_config_bundles(const std::string& config_file) {
+Result<CornerNoiseModel> read_corner_calibration(const std::string& file) {
+  auto text = read_config_text(file);
+  if (!text) return std::unexpected(text.error());
+  auto root = parse_toml(*text, file);
+  if (!root) return std::unexpected(root.error());
+  const toml::table* table = root->get_as<toml::table>("corner_model");
+  if (!table) return fail(fmt::format("corner calibration '{}': no [corner_model] table", file));
+  ConfigErrors errors;
+  TableReader r(*table, "corner_model", corner_calibration_spec(), file, errors);
+  const CornerNoiseModel model = read_corner_model_keys(r, CornerNoiseModel{});
+  if (!errors.empty()) return fail(errors.joined());
+  return model;
+}
+
+namespace {
+// Every fiducial device of a covtrackd config file, read as the daemon reads it; every
+// problem of those devices' tables in one error.
+Result<std::vector<FiducialConfig>> read_fiducial_devices(const std::string& config_file) {
   auto text = read_config_text(config_file);
   if (!text) return std::unexpected(text.error());
   auto root = parse_toml(*text, config_file);
   if (!root) return std::unexpected(root.error());
   ConfigErrors errors;
-  std::vector<TagBundle> bundles;
+  std::vector<FiducialConfig> out;
   if (const toml::table* devices = root->get_as<toml::table>("devices"))
     for (const auto& [name, node] : *devices) {
       const toml::table* device = node.as_table();
@@ -247,11 +295,31 @@ Result<std::vector<TagBundle>> read_config_bundles(const std::string& config_fil
         continue;
       const std::string device_name(name.str());
       TableReader r(*device, "devices." + device_name, fiducial_device_spec(), config_file, errors);
-      const FiducialConfig c = read_fiducial_config(r, device_name);
-      bundles.insert(bundles.end(), c.bundles.begin(), c.bundles.end());
+      out.push_back(read_fiducial_config(r, device_name));
     }
   if (!errors.empty()) return fail(errors.joined());
+  return out;
+}
+}  // namespace
+
+Result<std::vector<TagBundle>> read_config_bundles(const std::string& config_file) {
+  auto devices = read_fiducial_devices(config_file);
+  if (!devices) return std::unexpected(devices.error());
+  std::vector<TagBundle> bundles;
+  for (const FiducialConfig& c : *devices) bundles.insert(bundles.end(), c.bundles.begin(), c.bundles.end());
   return bundles;
+}
+
+Result<FiducialConfig> read_config_device(const std::string& config_file, const std::string& device) {
+  auto devices = read_fiducial_devices(config_file);
+  if (!devices) return std::unexpected(devices.error());
+  std::vector<std::string> names;
+  for (const FiducialConfig& c : *devices) {
+    if (c.device == device) return c;
+    names.push_back(c.device);
+  }
+  return fail(fmt::format("{}: no fiducial device '{}' (its fiducial devices: {})", config_file, device,
+                          names.empty() ? std::string("none") : fmt::format("{}", fmt::join(names, ", "))));
 }
 
 }  // namespace covtrack::fiducial

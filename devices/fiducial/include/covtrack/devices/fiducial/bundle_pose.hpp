@@ -85,4 +85,10 @@ struct BundlePose {
 Result<BundlePose> estimate_bundle_pose(const CameraModel& camera, const std::vector<BundleObservation>& observations,
                                         double ambiguity_chi2 = 40.0, double consistency_chi2 = 40.0);
 
+// The pose from all of `observations`' corners by Gauss-Newton from `start`, with its
+// covariance, and nothing else: no search for a second minimum, no agreement check. For
+// fits repeated from a known good start (the calibration leaves each tag out in turn).
+Result<BundlePose> refine_bundle_pose(const CameraModel& camera, const std::vector<BundleObservation>& observations,
+                                      const Pose& start);
+
 }  // namespace covtrack::fiducial

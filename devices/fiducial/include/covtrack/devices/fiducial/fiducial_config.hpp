@@ -18,6 +18,7 @@ struct FiducialConfig {
   std::string parent_frame = "camera";  // poses are T_camera_tag
   std::string source;          // a V4L2 camera index ("0"), a video file or an image pattern
   std::string calibration;     // OpenCV calibration file
+  std::string corner_calibration;  // this camera's corner model (covtrack calibrate-fiducial), if any
   DetectorOptions detector;
   CornerNoiseModel noise;
   double ambiguity_chi2 = 40;
@@ -34,15 +35,24 @@ struct FiducialConfig {
 
 const TableSpec& fiducial_device_spec();
 const TableSpec& fiducial_tag_spec();
+// The corner noise model's keys (corner_*), in a device's table or a corner_calibration file.
+std::vector<KeySpec> corner_model_keys();
+// The [corner_model] table of a file written by `covtrack calibrate-fiducial`.
+const TableSpec& corner_calibration_spec();
 const TableSpec& fiducial_bundle_spec();
 const TableSpec& fiducial_bundle_tag_spec();
 
 // Relative paths are taken from the config file's folder. Problems go to the reader.
 FiducialConfig read_fiducial_config(TableReader& device, const std::string& device_name);
 
+// A corner_calibration file's model; errors name the file, line and key.
+Result<CornerNoiseModel> read_corner_calibration(const std::string& file);
+
 // The tag bundles of every fiducial device in a covtrackd config file (for tools that
 // render or calibrate a bundle as the daemon will see it); every problem of those
 // devices' tables in one error.
 Result<std::vector<TagBundle>> read_config_bundles(const std::string& config_file);
+// One fiducial device of a covtrackd config file (for tools that calibrate it).
+Result<FiducialConfig> read_config_device(const std::string& config_file, const std::string& device);
 
 }  // namespace covtrack::fiducial
