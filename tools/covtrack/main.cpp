@@ -16,6 +16,9 @@ int main(int argc, char** argv) {
                                        "covtrack-vision");
   covtrack::cli::add_delegated_command(app, "render-tags", "Render AprilTags at known poses (images or video + truth)",
                                        "covtrack-vision");
+  covtrack::cli::add_delegated_command(app, "calibrate-fiducial",
+                                       "Fit a camera's corner noise model from frames of a board of tags",
+                                       "covtrack-vision");
   covtrack::cli::add_emulate_lenz_command(app);
   covtrack::cli::add_emulate_6dof_command(app);
   covtrack::cli::add_devices_command(app);

@@ -32,6 +32,7 @@ struct RenderArgs {
   std::string bundles_from;
   int frames = 60;
   double swing_deg = 20, period_frames = 60;
+  double wander_deg = 0, wander_m = 0;
   double noise = 3, blur = 0.8, black = 30, white = 220, background = 128;
   double gamma = 1, defocus = 0, vignetting = 0, full_well = 0;
   int jpeg = 0;
@@ -66,6 +67,30 @@ Pose camera_pose(const double* v) {
                 Eigen::AngleAxisd(v[4] * k, Vec3::UnitX())).toRotationMatrix();
   T.translation() = Vec3(v[0], v[1], v[2]);
   return T;
+}
+
+// One frame's random move, as a board waved in front of the camera: `turn` (up to
+// --wander-deg about each axis) about the tag's or bundle's own centre, then `shift` (up
+// to --wander-m along each camera axis). None without --wander-*.
+struct Wander {
+  Pose turn = Pose::Identity();
+  Vec3 shift = Vec3::Zero();
+  Pose apply(const Pose& T_camera_object) const {
+    Pose T = T_camera_object * turn;
+    T.translation() += shift;
+    return T;
+  }
+};
+
+Wander wander(const RenderArgs& a, std::mt19937_64& rng) {
+  Wander w;
+  if (a.wander_deg <= 0 && a.wander_m <= 0) return w;
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Vec3 angle = Vec3(u(rng), u(rng), u(rng)) * a.wander_deg * M_PI / 180;
+  w.turn.linear() = (Eigen::AngleAxisd(angle.x(), Vec3::UnitX()) * Eigen::AngleAxisd(angle.y(), Vec3::UnitY()) *
+                     Eigen::AngleAxisd(angle.z(), Vec3::UnitZ())).toRotationMatrix();
+  w.shift = Vec3(u(rng), u(rng), u(rng)) * a.wander_m;
+  return w;
 }
 
 // "id,size_m,x,y,z,roll_deg,pitch_deg,yaw_deg": T_camera_tag.
@@ -173,14 +198,14 @@ int run_render(const RenderArgs& a) {
   formation.true_distortion = camera->distortion;  // the lens the calibration describes
   std::mt19937_64 rng(a.seed);
   for (int f = 0; f < a.frames; ++f) {
-    // Each tag swings about its own vertical axis, so the frames show motion.
     // Each tag and each bundle swings about its own vertical axis, so the frames show motion.
     const double swing = a.swing_deg * M_PI / 180 * std::sin(2 * M_PI * f / a.period_frames);
     const Pose turn(Eigen::AngleAxisd(swing, Vec3::UnitY()).toRotationMatrix());
+    const Wander moved = wander(a, rng);
     std::vector<fiducial::RenderedTag> now;
-    for (const auto& t : tags) now.push_back({t.id, t.size_m, t.T_camera_tag * turn});
+    for (const auto& t : tags) now.push_back({t.id, t.size_m, moved.apply(t.T_camera_tag * turn)});
     for (const auto& b : bundles) {
-      const Pose T_camera_bundle = b.T_camera_bundle * turn;
+      const Pose T_camera_bundle = moved.apply(b.T_camera_bundle * turn);
       for (const auto& t : b.bundle.tags) now.push_back({t.id, t.size_m, T_camera_bundle * t.T_bundle_tag});
       const Eigen::Quaterniond q(T_camera_bundle.rotation());
       const Vec3 p = T_camera_bundle.translation();
@@ -222,6 +247,13 @@ void add_render_tags_command(CLI::App& app) {
   cmd->add_option("--frames", args->frames, "frame count")->capture_default_str()->check(CLI::Range(1, 1000000));
   cmd->add_option("--swing-deg", args->swing_deg, "yaw swing amplitude")->capture_default_str();
   cmd->add_option("--period-frames", args->period_frames, "frames per swing")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--wander-deg", args->wander_deg, "each frame, turn every tag and bundle about its centre by "
+                                                   "a random angle up to this about each axis (a board waved in "
+                                                   "front of the camera)")
+      ->capture_default_str()->check(CLI::Range(0.0, 90.0));
+  cmd->add_option("--wander-m", args->wander_m, "each frame, move every tag and bundle by up to this along "
+                                               "each camera axis")
+      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--noise", args->noise, "sensor noise sigma (grey levels)")->capture_default_str()->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--blur", args->blur, "optical blur sigma (px)")->capture_default_str()->check(CLI::Range(0.0, 20.0));
   cmd->add_option("--black", args->black, "tag black level")->capture_default_str();
