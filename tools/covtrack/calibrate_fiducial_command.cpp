@@ -12,7 +12,6 @@
 
 #include <fmt/core.h>
 #include <fmt/ranges.h>
-#include <opencv2/imgproc.hpp>
 
 #include "commands.hpp"
 #include "covtrack/devices/fiducial/board_calibration.hpp"
@@ -29,15 +28,6 @@ struct CalibrateArgs {
 
 constexpr const char* kName = "covtrack calibrate-fiducial";
 
-cv::Mat to_gray(const cv::Mat& frame) {
-  cv::Mat gray;
-  if (frame.channels() == 3) cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
-  else if (frame.channels() == 4) cv::cvtColor(frame, gray, cv::COLOR_BGRA2GRAY);
-  else gray = frame;
-  if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
-  return gray;
-}
-
 std::string model_file_text(const fiducial::CornerNoiseModel& m, const CalibrateArgs& a,
                             const fiducial::FiducialConfig& device, const fiducial::BoardFit& fit) {
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
@@ -51,14 +41,7 @@ std::string model_file_text(const fiducial::CornerNoiseModel& m, const Calibrate
       "[corner_model]\n",
       device.calibration, a.device, a.config, date, fit.frames_used, a.board, fit.residuals, fit.left_out,
       fit.before.mean_chi2, fit.after.mean_chi2);
-  const std::vector<std::pair<const char*, double>> keys = {
-      {"corner_gain_px", m.gain_px}, {"corner_floor_px", m.floor_px}, {"corner_aligned_px", m.aligned_px},
-      {"corner_shift_px", m.shift_px}, {"corner_shift_falloff", m.shift_falloff},
-      {"corner_shift_sigma_px", m.shift_sigma_px}, {"corner_scale_bias_per_blur", m.scale_bias_per_blur},
-      {"corner_scale_sigma_px", m.scale_sigma_px}, {"corner_scale_per_blur", m.scale_per_blur},
-      {"corner_edge_sigma_px", m.edge_sigma_px}, {"corner_edge_per_blur", m.edge_per_blur},
-      {"corner_tilt_sigma_px", m.tilt_sigma_px}, {"corner_tilt_per_blur", m.tilt_per_blur}};
-  for (const auto& [key, value] : keys) s += fmt::format("{} = {:.6g}\n", key, value);
+  for (const auto& f : fiducial::corner_model_fields()) s += fmt::format("{} = {:.6g}\n", f.key, m.*f.value);
   return s;
 }
 
@@ -108,6 +91,7 @@ int run_calibrate(const CalibrateArgs& a) {
 
   std::vector<fiducial::BoardFrame> frames;
   int read = 0, damaged = 0;
+  cv::Mat gray;
   while (read < a.max_frames) {
     auto frame = (*source)->next();
     if (!frame) return fmt::print(stderr, "{}: {}: {}\n", kName, source_name, frame.error().message), 1;
@@ -118,7 +102,7 @@ int run_calibrate(const CalibrateArgs& a) {
       fmt::print(stderr, "{}: damaged frame '{}': {}; skipped\n", kName, frame->name, frame->problem);
       continue;
     }
-    const cv::Mat gray = to_gray(frame->image);
+    fiducial::to_gray8(frame->image, gray);
     if (gray.cols != camera->width_px || gray.rows != camera->height_px)
       return fmt::print(stderr, "{}: '{}': frame is {}x{} but the calibration '{}' is for {}x{}\n", kName,
                         frame->name.empty() ? source_name : frame->name, gray.cols, gray.rows, device->calibration,

@@ -42,6 +42,17 @@ Result<TagCorners> corners_of(const BundleObservation& o) {
   return t;
 }
 
+// Every observation's corners, in the order given.
+Result<std::vector<TagCorners>> corners_of_all(const std::vector<BundleObservation>& observations) {
+  std::vector<TagCorners> tags;
+  for (const auto& o : observations) {
+    auto t = corners_of(o);
+    if (!t) return std::unexpected(t.error());
+    tags.push_back(*t);
+  }
+  return tags;
+}
+
 // Whitened residuals of the tags' corners at T; false when a corner is behind the camera.
 bool residuals(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T, Eigen::VectorXd& r) {
   r.resize(8 * static_cast<Eigen::Index>(tags.size()));
@@ -165,12 +176,9 @@ Result<BundlePose> estimate_bundle_pose(const CameraModel& cam, const std::vecto
                                         double ambiguity_chi2, double consistency_chi2) {
   if (observations.empty()) return fail("no tag of the bundle in view");
   if (observations.size() == 1) return from_one_tag(observations[0]);
-  std::vector<TagCorners> tags;
-  for (const auto& o : observations) {
-    auto t = corners_of(o);
-    if (!t) return std::unexpected(t.error());
-    tags.push_back(*t);
-  }
+  auto corners = corners_of_all(observations);
+  if (!corners) return std::unexpected(corners.error());
+  const std::vector<TagCorners>& tags = *corners;
 
   // Starts: both solutions of every tag, mapped to the bundle, lowest cost first. A start
   // near a minimum already found would only find it again (0.01: 0.6 degrees or 1 cm, far
@@ -267,12 +275,9 @@ Result<BundlePose> estimate_bundle_pose(const CameraModel& cam, const std::vecto
 
 Result<BundlePose> refine_bundle_pose(const CameraModel& cam, const std::vector<BundleObservation>& observations,
                                       const Pose& start) {
-  std::vector<TagCorners> tags;
-  for (const auto& o : observations) {
-    auto t = corners_of(o);
-    if (!t) return std::unexpected(t.error());
-    tags.push_back(*t);
-  }
+  auto corners = corners_of_all(observations);
+  if (!corners) return std::unexpected(corners.error());
+  const std::vector<TagCorners>& tags = *corners;
   const Fit fit = gauss_newton(cam, tags, start);
   if (!std::isfinite(fit.cost) || !fit.covariance.allFinite()) return fail("no bundle pose near the start fits");
   BundlePose out;

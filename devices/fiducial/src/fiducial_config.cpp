@@ -91,6 +91,18 @@ std::vector<KeySpec> corner_model_keys() {
   };
 }
 
+const std::vector<CornerModelField>& corner_model_fields() {
+  using M = CornerNoiseModel;
+  static const std::vector<CornerModelField> fields{
+      {"corner_gain_px", &M::gain_px}, {"corner_floor_px", &M::floor_px}, {"corner_aligned_px", &M::aligned_px},
+      {"corner_shift_px", &M::shift_px}, {"corner_shift_falloff", &M::shift_falloff},
+      {"corner_shift_sigma_px", &M::shift_sigma_px}, {"corner_scale_bias_per_blur", &M::scale_bias_per_blur},
+      {"corner_scale_sigma_px", &M::scale_sigma_px}, {"corner_scale_per_blur", &M::scale_per_blur},
+      {"corner_edge_sigma_px", &M::edge_sigma_px}, {"corner_edge_per_blur", &M::edge_per_blur},
+      {"corner_tilt_sigma_px", &M::tilt_sigma_px}, {"corner_tilt_per_blur", &M::tilt_per_blur}};
+  return fields;
+}
+
 const TableSpec& corner_calibration_spec() {
   static const TableSpec spec{"corner_model (a corner_calibration file)", "fiducial driver", corner_model_keys()};
   return spec;
@@ -147,19 +159,7 @@ std::string relative_to_config(const std::string& path, const std::string& confi
 
 // The corner_* keys of `r`, each defaulting to `m`'s value.
 CornerNoiseModel read_corner_model_keys(TableReader& r, CornerNoiseModel m) {
-  m.gain_px = r.number("corner_gain_px", m.gain_px);
-  m.floor_px = r.number("corner_floor_px", m.floor_px);
-  m.aligned_px = r.number("corner_aligned_px", m.aligned_px);
-  m.shift_px = r.number("corner_shift_px", m.shift_px);
-  m.shift_falloff = r.number("corner_shift_falloff", m.shift_falloff);
-  m.shift_sigma_px = r.number("corner_shift_sigma_px", m.shift_sigma_px);
-  m.scale_bias_per_blur = r.number("corner_scale_bias_per_blur", m.scale_bias_per_blur);
-  m.scale_sigma_px = r.number("corner_scale_sigma_px", m.scale_sigma_px);
-  m.scale_per_blur = r.number("corner_scale_per_blur", m.scale_per_blur);
-  m.edge_sigma_px = r.number("corner_edge_sigma_px", m.edge_sigma_px);
-  m.edge_per_blur = r.number("corner_edge_per_blur", m.edge_per_blur);
-  m.tilt_sigma_px = r.number("corner_tilt_sigma_px", m.tilt_sigma_px);
-  m.tilt_per_blur = r.number("corner_tilt_per_blur", m.tilt_per_blur);
+  for (const CornerModelField& f : corner_model_fields()) m.*f.value = r.number(f.key, m.*f.value);
   if (m.floor_px <= 0 && m.gain_px <= 0)
     r.error("corner_floor_px", "the corner noise model needs a floor or a gain above zero");
   return m;

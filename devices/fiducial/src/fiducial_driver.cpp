@@ -82,10 +82,7 @@ class FiducialDriver final : public Driver {
       }
       const cv::Mat& frame = read->image;
       const std::int64_t time_us = now_us();
-      if (frame.channels() == 3) cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
-      else if (frame.channels() == 4) cv::cvtColor(frame, gray, cv::COLOR_BGRA2GRAY);
-      else gray = frame;
-      if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
+      to_gray8(frame, gray);
       if (gray.cols != camera_.width_px || gray.rows != camera_.height_px)
         return fail(fmt::format("'{}': frame is {}x{} but the calibration '{}' is for {}x{}",
                                 read->name.empty() ? config_.source : read->name, gray.cols,

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "covtrack/devices/file_kind.hpp"
@@ -117,6 +118,13 @@ Result<void> check_frame_source(const std::string& source) {
   auto opened = open_frame_source(source, false);
   if (!opened) return std::unexpected(opened.error());
   return {};
+}
+
+void to_gray8(const cv::Mat& frame, cv::Mat& gray) {
+  if (frame.channels() == 3) cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
+  else if (frame.channels() == 4) cv::cvtColor(frame, gray, cv::COLOR_BGRA2GRAY);
+  else gray = frame;
+  if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
 }
 
 }  // namespace covtrack::fiducial

@@ -37,6 +37,12 @@ const TableSpec& fiducial_device_spec();
 const TableSpec& fiducial_tag_spec();
 // The corner noise model's keys (corner_*), in a device's table or a corner_calibration file.
 std::vector<KeySpec> corner_model_keys();
+// Each corner_* key with the model's value it sets: one list for reading and writing them.
+struct CornerModelField {
+  const char* key;
+  double CornerNoiseModel::*value;
+};
+const std::vector<CornerModelField>& corner_model_fields();
 // The [corner_model] table of a file written by `covtrack calibrate-fiducial`.
 const TableSpec& corner_calibration_spec();
 const TableSpec& fiducial_bundle_spec();

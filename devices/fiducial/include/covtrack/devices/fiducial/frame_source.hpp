@@ -48,4 +48,8 @@ Result<std::unique_ptr<FrameSource>> open_frame_source(const std::string& source
 // a device node, not streamed, so the check does not disturb a daemon already using it.
 Result<void> check_frame_source(const std::string& source);
 
+// A frame as the detector takes it: 8-bit grey (colour converted, other depths scaled
+// down), into `gray` so a caller's buffer is reused from frame to frame.
+void to_gray8(const cv::Mat& frame, cv::Mat& gray);
+
 }  // namespace covtrack::fiducial
