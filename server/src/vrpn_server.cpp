@@ -25,6 +25,9 @@ namespace {
 constexpr int kPollMs = 50;  // a stop is noticed within this
 // Reports waiting for the server thread; beyond this the oldest go (it has fallen behind).
 constexpr std::size_t kMaxQueuedReports = 4096;
+// The kernel's share of a client's unsent bytes. Fixed (Linux would otherwise grow it to
+// megabytes): reports stuck there are seconds old before a slow client is noticed.
+constexpr int kSocketSendBuffer = 64 * 1024;
 
 // VRPN's connection request: "<host> <port>" and a NUL, asking the server to connect to
 // the client's TCP port. Only the port is used: the connection goes to the address the
@@ -201,6 +204,7 @@ void VrpnServer::add_client(vrpn::Socket socket, const sockaddr_in& peer, VrpnCl
                  clients_.size());
     return;
   }
+  setsockopt(socket.fd(), SOL_SOCKET, SO_SNDBUF, &kSocketSendBuffer, sizeof kSocketSendBuffer);
   clients_.push_back(
       std::make_unique<VrpnClientLink>(std::move(socket), peer, origin, tracker_names_, config_.max_queued_bytes));
   spdlog::info("vrpn_server: client {} {}", vrpn::to_string(peer),

@@ -187,6 +187,7 @@ TEST(VrpnServer, MalformedClientsAreDroppedWithAReasonAndOthersAreServed) {
   // Silent: no cookie ever.
   test::VrpnTestClient silent;
   ASSERT_TRUE(silent.connect_tcp(38863));
+  ASSERT_TRUE(silent.send_raw({}));
   EXPECT_TRUE(silent.closed_by_server_within(15)) << daemon.log();
   EXPECT_TRUE(daemon.log_shows("no VRPN handshake within 5 s", 5)) << daemon.log();
 
