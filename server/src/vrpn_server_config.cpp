@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -41,15 +42,16 @@ VrpnTrackerConfig read_tracker(TableReader& r, const std::map<std::string, std::
   t.streams = r.strings("streams");
   if (r.has("streams") && t.streams.empty()) r.error("streams", "lists no stream");
   std::string first_stream;
+  std::set<std::string> seen;
   for (const auto& text : t.streams) {
     const auto stream = split_stream(text);
     if (!stream) {
       r.error("streams", fmt::format("'{}' is no stream: write \"device/sensor\"", text));
       continue;
     }
-    if (std::count(t.streams.begin(), t.streams.end(), text) > 1) {
+    if (!seen.insert(text).second) {
       r.error("streams", fmt::format("'{}' is listed twice (one sensor number each)", text));
-      break;
+      continue;
     }
     const auto frame = device_frames.find(stream->device);
     if (frame == device_frames.end()) {
