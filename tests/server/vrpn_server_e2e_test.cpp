@@ -34,8 +34,8 @@ const std::string kUrl = "udpm://239.255.76.67:7752?ttl=0";
 // A daemon with two sim sensors served as Tracker0, its log in a file.
 class ServingDaemon {
  public:
-  ServingDaemon(int port, int rate_hz, std::size_t max_queued_bytes = 262144) {
-    const std::string base = ::testing::TempDir() + "/vrpn_server_" + std::to_string(port);
+  ServingDaemon(int port, int rate_hz, std::size_t max_queued_bytes = 262144, const std::string& name = "first") {
+    const std::string base = ::testing::TempDir() + "/vrpn_server_" + name + std::to_string(port);
     log_ = base + ".log";
     std::ofstream(base + ".toml") << fmt::format(R"(
 [devices.sim]
@@ -72,6 +72,7 @@ streams = ["sim/head", "sim/wand"]
     }
     return false;
   }
+  std::optional<int> wait(double seconds) { return process_->wait(seconds); }
   // The daemon is still running, and stops cleanly on SIGTERM.
   void expect_clean_stop() {
     int status = 0;
@@ -234,4 +235,16 @@ TEST(VrpnServer, AClientThatDoesNotReadIsDroppedWhilePublishingGoesOn) {
   EXPECT_GT(vrpn_rate, 100);
   EXPECT_TRUE(stalled.closed_by_server_within(10));
   daemon.expect_clean_stop();
+}
+
+TEST(VrpnServer, APortInUseStopsTheStartWithCode1NamingTheAddress) {
+  ServingDaemon first(38865, 100);
+  test::VrpnTestClient client;
+  ASSERT_TRUE(client.connect_tcp(38865)) << "the first daemon serves";
+  ServingDaemon second(38865, 100, 262144, "second");
+  const auto status = second.wait(10);
+  ASSERT_TRUE(status) << "the second daemon did not exit\n" << second.log();
+  EXPECT_TRUE(WIFEXITED(*status) && WEXITSTATUS(*status) == 1) << "status " << *status;
+  EXPECT_NE(second.log().find("vrpn_server: cannot bind TCP 127.0.0.1:38865"), std::string::npos) << second.log();
+  first.expect_clean_stop();
 }
