@@ -10,7 +10,9 @@
 #include <sys/socket.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -138,6 +140,11 @@ TEST(VrpnServer, ATcpClientGetsEachStreamAsItsSensorEqualToLcm) {
       EXPECT_NEAR(std::abs(q[3] * w[0] + q[0] * w[1] + q[1] * w[2] + q[2] * w[3]), 1.0, 1e-12);
     }
   EXPECT_GE(compared, 80);
+  std::vector<std::int64_t> age_us;
+  for (const auto& r : client.reports[0]) age_us.push_back(r.arrival_us - r.time_us);
+  std::sort(age_us.begin(), age_us.end());
+  std::printf("measurement to VRPN client over TCP: median %lld us, largest %lld us (%zu reports)\n",
+              static_cast<long long>(age_us[age_us.size() / 2]), static_cast<long long>(age_us.back()), age_us.size());
   daemon.expect_clean_stop();
 }
 

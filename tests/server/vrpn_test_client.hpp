@@ -41,7 +41,8 @@ inline vrpn::Socket connect_when_listening(int port, double seconds) {
 
 struct ReceivedReport {
   vrpn::TrackerReport report;
-  std::int64_t time_us = 0;
+  std::int64_t time_us = 0;     // the header's: the measurement time
+  std::int64_t arrival_us = 0;  // this host's clock when it was read
   bool by_udp = false;
 };
 
@@ -153,7 +154,10 @@ class VrpnTestClient {
       if (m.sender != tracker_) continue;
       if (m.type == vrpn::kPong) ++pongs;
       if (m.type != vrpn::kTrackerPosQuat) continue;
-      if (auto r = vrpn::decode_pos_quat(m.payload)) reports[r->sensor].push_back({*r, m.time_us, by_udp});
+      const auto arrival = std::chrono::duration_cast<std::chrono::microseconds>(
+                               std::chrono::system_clock::now().time_since_epoch())
+                               .count();
+      if (auto r = vrpn::decode_pos_quat(m.payload)) reports[r->sensor].push_back({*r, m.time_us, arrival, by_udp});
     }
   }
 
