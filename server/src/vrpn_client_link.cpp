@@ -90,6 +90,8 @@ void VrpnClientLink::open_udp() {
     return;
   }
   udp_ = std::move(*udp);
+  spdlog::info("vrpn_server: client {} takes its reports over UDP at {}:{}", peer_, session_.peer_udp()->host,
+               session_.peer_udp()->port);
 }
 
 Result<void> VrpnClientLink::send_report(const std::string& tracker, const vrpn::TrackerReport& report,
