@@ -150,6 +150,8 @@ void VrpnServer::send_reports() {
     std::lock_guard lock(mutex_);
     reports.swap(queue_);
   }
+  if (const auto dropped = queue_drops_.exchange(0))
+    spdlog::warn("vrpn_server: fell behind the publishers: {} reports dropped", dropped);
   for (const auto& r : reports)
     for (std::size_t i = clients_.size(); i-- > 0;)
       if (auto sent = clients_[i]->send_report(tracker_names_[r.tracker], r.report, r.time_us); !sent)
