@@ -11,6 +11,7 @@
 #include "covtrack/protocol/lcm_url.hpp"
 #include "host.hpp"
 #include "stop_signals.hpp"
+#include "vrpn_server.hpp"
 
 namespace {
 // Exit codes (also in --help and README.md).
@@ -18,7 +19,7 @@ constexpr int kExitCannotStart = 1;
 constexpr int kExitBadConfig = 2;
 constexpr int kExitDeviceDidNotStop = 3;
 constexpr const char* kExitCodes =
-    "Exit codes: 0 stopped by SIGINT/SIGTERM; 1 could not start (LCM); 2 bad config or usage; "
+    "Exit codes: 0 stopped by SIGINT/SIGTERM; 1 could not start (LCM, or the VRPN server's port); 2 bad config or usage; "
     "3 stopped, but a device's thread did not end within daemon.stop_timeout_s (named on the log; "
     "the daemon exits anyway). A stop signal before the devices start ends covtrackd at once, "
     "by that signal (status 130 or 143 in a shell).";
@@ -81,7 +82,22 @@ int main(int argc, char** argv) {
     return kExitCannotStart;
   }
 
+  // Declared before the host: destroyed after the device threads that feed it.
+  std::unique_ptr<covtrack::server::VrpnServer> vrpn_server;
+  if (config->vrpn_server) {
+    auto opened = covtrack::server::VrpnServer::open(*config->vrpn_server);
+    if (!opened) {
+      std::cerr << "covtrackd: " << opened.error().message << "\n";
+      return kExitCannotStart;
+    }
+    vrpn_server = std::move(*opened);
+    vrpn_server->start();
+  }
   covtrack::server::Host host(*config, **lcm);
+  if (vrpn_server)
+    host.tap_poses([server = vrpn_server.get()](const std::string& device, const covtrack::PoseSample& s) {
+      server->offer(device, s);
+    });
   host.start();
   spdlog::info("covtrackd: {} device(s) publishing on {}", config->devices.size(), url);
 
