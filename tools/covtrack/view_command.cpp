@@ -22,6 +22,7 @@
 #include <fmt/ranges.h>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
@@ -117,7 +118,7 @@ int run_view(const ViewArgs& args) {
     return fail_with(fmt::format("{}: {}", args.scene_path, r.error().message), 2);
   if (args.live) {
     auto sub = client::Subscriber::open({.lcm_url = args.lcm_url});
-    if (!sub) return fail_with(sub.error().message, 2);
+    if (!sub) return fail_with(sub.error().message, program::kExitRuntimeError);
     subscriber = std::move(*sub);
     // Streams the scene does not use are simply not in the graph.
     (void)subscriber->on_pose(".*", [&graph](const client::TrackedTransform& t) { (void)graph.update(t.stream, t); });
@@ -222,25 +223,25 @@ void add_view_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("view", "Draw the objects' error regions over the camera view");
   cmd->add_option("SCENE", args->scene_path, "Scene file (config/scene_schema.md)")->required();
   cmd->add_flag("--live", args->live, "Tracked transforms from the daemon's streams, not the scene's values");
-  cmd->add_option("--lcm-url", args->lcm_url, "LCM URL for --live (default: $LCM_DEFAULT_URL or LCM's)");
+  cmd->add_option("--lcm-url,-u", args->lcm_url, "LCM URL for --live (default: $LCM_DEFAULT_URL or LCM's)");
   cmd->add_option("--log", args->log_path, "Follow a recorded session (LCM log) at its own time");
-  cmd->add_option("--speed", args->speed, "Speed factor of --log")->capture_default_str()->check(CLI::Range(0.01, 1000.0));
+  cmd->add_option("--speed,-s", args->speed, "Speed factor of --log")->capture_default_str()->check(program::in_range(0.01, 1000.0));
   cmd->add_option("--png", args->png_path, "Write one frame (at the end of --duration, if given) and exit");
   cmd->add_option("--video", args->video_path, "Write the frames to this video file (MJPG AVI)");
   cmd->add_option("--background", args->background,
                   "#rrggbb, an image file, a video file (looped) or camera:N (default with --log: the "
                   "log's camera frames, if it has any)");
-  cmd->add_option("--duration", args->duration_s,
+  cmd->add_option("--duration,-d", args->duration_s,
                   "Seconds to run (default: until q/Esc/Ctrl-C; 10 for --video); offline (no --live, no --log) "
                   "into a file, scene seconds rendered without waiting")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--fps", args->fps, "Frames per second")->capture_default_str()->check(CLI::Range(0.1, 240.0));
+      ->check(program::non_negative());
+  cmd->add_option("--fps", args->fps, "Frames per second")->capture_default_str()->check(program::in_range(0.1, 240.0));
   cmd->add_option("--confidence", args->confidence, "Confidence of the regions (default: the scene's)")
-      ->check(CLI::Range(0.5, 0.9999));
+      ->check(program::in_range(0.5, 0.9999));
   const std::map<std::string, client::ProjectionMethod> methods = {
       {"unscented", client::ProjectionMethod::unscented}, {"linear", client::ProjectionMethod::linear}};
   cmd->add_option("--method", args->method, "Vertex projection: unscented or linear")
-      ->transform(CLI::CheckedTransformer(methods));
+      ->transform(program::one_of(methods));
   cmd->callback([args] {
     if (const int code = run_view(*args); code != 0) throw CLI::RuntimeError(code);
   });
