@@ -144,6 +144,7 @@ int run_view(const ViewArgs& args) {
   const cv::Size size(model->camera.width_px, model->camera.height_px);
   std::string warning;
   ViewBackground background(args.background, size, warning);
+  if (background.camera_unavailable()) return fail_with(warning, program::kExitRuntimeError);
   std::optional<cv::VideoWriter> video;
   if (!args.video_path.empty()) {
     video.emplace(args.video_path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), args.fps, size);
