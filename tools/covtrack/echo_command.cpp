@@ -181,7 +181,7 @@ int run_echo(const EchoOptions& o) {
       hinted = true;
       if ((*sub)->streams().empty() && (*sub)->devices().empty())
         std::cerr << fmt::format("covtrack echo: nothing received for {} s on {} (streams '{}'): is covtrackd "
-                                 "running and publishing there? (covtrackd --config config/sim.toml)\n",
+                                 "running and publishing there? (covtrackd --config config/sim.toml); still waiting, Ctrl-C ends\n",
                                  kSilenceHint.count(), effective_lcm_url(o.subscriber.lcm_url),
                                  o.subscriber.pattern);
     }
