@@ -32,6 +32,7 @@
 #include "subscriber_summary.hpp"
 #include "view_background.hpp"
 #include "view_log.hpp"
+#include "view_video.hpp"
 #include "view_widgets.hpp"
 
 namespace covtrack::cli {
@@ -46,7 +47,7 @@ struct ViewArgs {
   std::string png_path;
   std::string video_path;
   std::string background;
-  double duration_s = 0;  // 0: until stopped (window), one frame (--png), 10 s (--video)
+  double duration_s = 0;  // 0: until stopped (window), one frame (--png), the whole --log or 10 s (--video)
   double fps = 30;
   double confidence = 0;
   client::ProjectionMethod method = client::ProjectionMethod::unscented;
@@ -99,6 +100,10 @@ int run_view(const ViewArgs& args) {
     return code;
   };
   const bool window = args.png_path.empty() && args.video_path.empty();
+  std::optional<VideoFormat> video_format;
+  if (!args.video_path.empty() && !(video_format = video_format_for(args.video_path)))
+    return fail_with(fmt::format("--video {}: name it .mp4 (H.264) or .webm (VP9), formats browsers play",
+                                 args.video_path), program::kExitUsageError);
   if (window && !std::getenv("DISPLAY"))
     return fail_with("no display (DISPLAY is not set): use --png FILE or --video FILE", 2);
   const auto model = load_regions_model(args.scene_path, args.confidence);
@@ -147,18 +152,21 @@ int run_view(const ViewArgs& args) {
   if (background.camera_unavailable()) return fail_with(warning, program::kExitRuntimeError);
   std::optional<cv::VideoWriter> video;
   if (!args.video_path.empty()) {
-    video.emplace(args.video_path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), args.fps, size);
-    if (!video->isOpened()) return fail_with(fmt::format("cannot write video {}", args.video_path), 1);
+    auto opened = open_video(args.video_path, *video_format, args.fps, size);
+    if (!opened) return fail_with(opened.error().message, program::kExitRuntimeError);
+    video.emplace(std::move(*opened));
   }
   if (window) cv::namedWindow("covtrack view", cv::WINDOW_AUTOSIZE);
 
   install_stop_signals();
   // Scripts and tests wait for this line: from here on every message counts.
   if (subscriber) std::cerr << "covtrack view: following the streams on " << effective_lcm_url(args.lcm_url) << "\n";
-  const double duration_s = args.duration_s > 0 ? args.duration_s : (video ? 10.0 : 0.0);
-  // Offline into a file, nothing outside sets the pace: frames are rendered at their
-  // scene times as fast as they can be, and the same command gives the same pictures.
-  const bool virtual_clock = fixed && !window;
+  // A video of a log covers all of it; one of a scene or of live streams, 10 s.
+  const double duration_s = args.duration_s > 0 ? args.duration_s : (video && !log ? 10.0 : 0.0);
+  // Offline into a file (a scene or a log), nothing outside sets the pace: frames are
+  // rendered at their scene or log times as fast as they can be, and the same command
+  // gives the same pictures.
+  const bool virtual_clock = !args.live && !window;
   const auto start = std::chrono::steady_clock::now();
   const auto period = std::chrono::duration<double>(1.0 / args.fps);
   for (long frame_index = 0;; ++frame_index) {
@@ -228,13 +236,14 @@ void add_view_command(CLI::App& app) {
   cmd->add_option("--log", args->log_path, "Follow a recorded session (LCM log) at its own time");
   cmd->add_option("--speed,-s", args->speed, "Speed factor of --log")->capture_default_str()->check(program::in_range(0.01, 1000.0));
   cmd->add_option("--png", args->png_path, "Write one frame (at the end of --duration, if given) and exit");
-  cmd->add_option("--video", args->video_path, "Write the frames to this video file (MJPG AVI)");
+  cmd->add_option("--video", args->video_path,
+                  "Write the frames to this video file: FILE.mp4 (H.264) or FILE.webm (VP9), which browsers play");
   cmd->add_option("--background", args->background,
                   "#rrggbb, an image file, a video file (looped) or camera:N (default with --log: the "
                   "log's camera frames, if it has any)");
   cmd->add_option("--duration,-d", args->duration_s,
-                  "Seconds to run (default: until q/Esc/Ctrl-C; 10 for --video); offline (no --live, no --log) "
-                  "into a file, scene seconds rendered without waiting")
+                  "Seconds to run (default: until q/Esc/Ctrl-C; for --video the whole --log, else 10); offline "
+                  "(no --live) into a file, scene or log seconds rendered without waiting")
       ->check(program::non_negative());
   cmd->add_option("--fps", args->fps, "Frames per second")->capture_default_str()->check(program::in_range(0.1, 240.0));
   cmd->add_option("--confidence", args->confidence, "Confidence of the regions (default: the scene's)")
