@@ -85,6 +85,11 @@ Result<int> read_positive_int(const cv::FileStorage& fs, const std::string& file
   if (!node.isInt()) return fail(fmt::format("{}: key '{}' is not an integer", file, key));
   const int v = static_cast<int>(node);
   if (v <= 0) return fail(fmt::format("{}: key '{}' must be positive, is {}", file, key, v));
+  // Views and renders allocate an image of this size: a damaged value must not ask for
+  // terabytes. 16384 px is twice an 8K sensor's width.
+  constexpr int kLargestSide_px = 16384;
+  if (v > kLargestSide_px)
+    return fail(fmt::format("{}: key '{}' is {} px, more than the {} px covtrack accepts", file, key, v, kLargestSide_px));
   return v;
 }
 

@@ -361,6 +361,15 @@ TEST(CameraFile, MissingImageSizeAndUnsupportedDistortion) {
   EXPECT_NE(cam.error().message.find("distortion_coefficients"), std::string::npos);
 }
 
+TEST(CameraFile, AnImpossibleImageSizeIsAnErrorNotAnAllocation) {
+  const auto path = write_temp("covtrack_cam_huge.yml", std::string("%YAML:1.0\n---\nimage_width: 2000000000\n"
+                                                                    "image_height: 480\n") + kMatrix + kDist);
+  const auto cam = load_camera(path);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find("image_width"), std::string::npos) << cam.error().message;
+  EXPECT_NE(cam.error().message.find("2000000000"), std::string::npos) << cam.error().message;
+}
+
 TEST(CameraFile, GarbageIsAnErrorNotACrash) {
   const auto path = write_temp("covtrack_cam_garbage.yml", "%YAML:1.0\n---\n[[[ :: not yaml\n");
   const auto cam = load_camera(path);
