@@ -35,7 +35,7 @@ const TableSpec& daemon_spec() {
            0.01, 3600},
           {"stop_timeout_s", ValueType::Float, "s", "2",
            "at SIGINT/SIGTERM, longest wait for the device threads; a device still running then "
-           "is named and the daemon exits anyway, with code 3", 0.1, 600},
+           "is named and the daemon exits anyway, with code 4", 0.1, 600},
       }};
   return spec;
 }
