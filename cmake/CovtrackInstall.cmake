@@ -36,5 +36,6 @@ install(FILES ${PROJECT_BINARY_DIR}/covtrackConfig.cmake ${PROJECT_BINARY_DIR}/c
 # right wherever the tree is installed (`cmake --install --prefix`, a Debian package).
 set(pc_dir ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
 file(RELATIVE_PATH COVTRACK_PC_TO_PREFIX /prefix/${pc_dir} /prefix)
+string(REGEX REPLACE "/$" "" COVTRACK_PC_TO_PREFIX "${COVTRACK_PC_TO_PREFIX}")
 configure_file(cmake/covtrack.pc.in ${PROJECT_BINARY_DIR}/covtrack.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/covtrack.pc DESTINATION ${pc_dir} COMPONENT dev)
