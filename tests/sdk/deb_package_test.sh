@@ -49,7 +49,7 @@ $exec_start --check || fail "$exec_start --check"
   || fail "the installed daemon and covtrack echo"
 [ "$(grep -c '"device"' "$tmp/echo.txt")" -eq 5 ] || { cat "$tmp/echo.txt"; fail "covtrack echo heard no 5 poses"; }
 
-(cd / && env -u PYTHONPATH python3 -c 'import covtrack; print(covtrack.__file__)') >"$tmp/py.txt" || fail "import covtrack"
+(cd / && env -u PYTHONPATH /usr/bin/python3 -c 'import covtrack; print(covtrack.__file__)') >"$tmp/py.txt" || fail "import covtrack"
 grep -q '^/usr/lib/python3' "$tmp/py.txt" || fail "covtrack imported from $(cat "$tmp/py.txt")"
 
 # covtrack-dev: one file against /usr alone (not /usr/local).

@@ -3,9 +3,9 @@
 # examples/ built out of tree against it (find_package(covtrack)), one file built with
 # pkg-config alone, and the programs run from the prefix. Run inside a private network
 # namespace (tests/netns_run.sh): the live examples subscribe to the installed covtrackd.
-# Usage: sdk_install_test.sh BUILD_DIR SOURCE_DIR CMAKE CXX   (PYTHONPATH: the build's module)
+# Usage: sdk_install_test.sh BUILD_DIR SOURCE_DIR CMAKE CXX PYTHON   (PYTHONPATH: the build's module)
 set -eu
-build=$1 src=$2 cmake=$3 cxx=$4
+build=$1 src=$2 cmake=$3 cxx=$4 python=$5
 tmp=$(mktemp -d)
 daemon=
 cleanup() { [ -z "$daemon" ] || kill "$daemon" 2>/dev/null || true; rm -rf "$tmp"; }
@@ -37,7 +37,7 @@ log=$src/tests/data/lenz_session.lcm
 head -c "$(($(wc -c <"$log") - 10))" "$log" >"$tmp/truncated.lcm"
 for l in "$log" "$tmp/truncated.lcm"; do
   "$tmp/examples/read_log" "$l" >"$tmp/got.txt" || fail "read_log $l"
-  python3 "$src/tests/sdk/expected_log_summary.py" "$l" read_log >"$tmp/want.txt"
+  "$python" "$src/tests/sdk/expected_log_summary.py" "$l" read_log >"$tmp/want.txt"
   diff "$tmp/want.txt" "$tmp/got.txt" || fail "read_log $l differs from covtrack.read_log (- want, + got)"
   grep -q " ok " "$tmp/got.txt" || fail "read_log found no stream in $l"
 done
@@ -49,7 +49,7 @@ PKG_CONFIG_PATH=$(dirname "$(find "$prefix" -name covtrack.pc)") pkg-config --cf
 # shellcheck disable=SC2046
 "$cxx" -std=c++23 "$src/tests/sdk/pkgconfig_probe.cpp" $(cat "$tmp/pc.txt") -o "$tmp/probe" || fail "pkg-config build"
 "$tmp/probe" "$log" >"$tmp/got.txt" || fail "probe"
-python3 "$src/tests/sdk/expected_log_summary.py" "$log" probe >"$tmp/want.txt"
+"$python" "$src/tests/sdk/expected_log_summary.py" "$log" probe >"$tmp/want.txt"
 diff "$tmp/want.txt" "$tmp/got.txt" || fail "probe differs from covtrack.read_log"
 
 # Live: the installed daemon with the demo's config; the examples run for a fixed time each.
