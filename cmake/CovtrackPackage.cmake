@@ -23,6 +23,9 @@ set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 # Install with DESTDIR and the real prefix, so that packaging/install_service.cmake sees
 # /usr and puts the config in /etc.
 set(CPACK_SET_DESTDIR ON)
+# Programs without their debug information (-g): some 100 MB each with it. Static
+# libraries keep their symbols (CMake never strips them).
+set(CPACK_STRIP_FILES ON)
 
 set(CPACK_COMPONENTS_ALL runtime python dev)
 set(CPACK_COMPONENT_RUNTIME_GROUP covtrack)
