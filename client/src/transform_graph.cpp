@@ -67,7 +67,10 @@ Result<void> TransformGraph::add_edge(const std::string& parent, const std::stri
   const FrameIndex c = existing_child ? *existing_child : add_frame(child);
   tree_[tree_of(c)] = tree_of(p);
   for (const EdgeSource& source : edge.sources)
-    if (const auto* tracked = std::get_if<TrackedSource>(&source)) ++bound_streams_[tracked->stream.key()];
+    if (const auto* tracked = std::get_if<TrackedSource>(&source)) {
+      ++bound_streams_[tracked->stream.key()];
+      stream_parent_.emplace(tracked->stream.key(), parent);
+    }
   frames_[c].parent = p;
   frames_[c].edge = std::move(edge);
   return {};
@@ -100,7 +103,22 @@ Result<void> TransformGraph::update(const StreamId& stream, const TrackedTransfo
   std::lock_guard lock(mutex_);
   if (!bound_streams_.contains(stream.key()))
     return fail("transform graph: no edge is bound to stream " + stream.key());
+  if (auto mismatch = mismatch_of(stream, report)) return fail(*mismatch);
   return store_report(stream, report);
+}
+
+std::optional<std::string> TransformGraph::frame_mismatch(const TrackedTransform& report) const {
+  std::lock_guard lock(mutex_);
+  return mismatch_of(report.stream, report);
+}
+
+std::optional<std::string> TransformGraph::mismatch_of(const StreamId& stream, const TrackedTransform& report) const {
+  const auto it = stream_parent_.find(stream.key());
+  if (it == stream_parent_.end() || report.parent_frame.empty() || report.parent_frame == it->second)
+    return std::nullopt;
+  return "stream " + stream.key() + " reports its pose relative to frame '" + report.parent_frame +
+         "', but the graph attaches it to frame '" + it->second +
+         "': not used (set the device's parent_frame, or the scene's parent, so that they agree)";
 }
 
 Result<void> TransformGraph::update(const std::string& edge_child_frame, const TrackedTransform& report) {

@@ -245,6 +245,32 @@ TEST(TransformGraph, LostOrNeverReportedIsUnbounded) {
   EXPECT_FALSE(g.query("world", "tool", kT0 + 1)->unbounded);
 }
 
+// A device configured in another parent frame than the scene expects: its reports are
+// refused with both frame names, never used as if they were relative to the scene's.
+TEST(TransformGraph, AReportInAnotherParentFrameIsRefusedWithBothNames) {
+  const StreamId id{"optical", "head"};
+  TransformGraph g;
+  ASSERT_TRUE(g.add_static_edge("world", "tracker_base", pose(0, 0, 2.2, 0, 0, 0)));
+  ASSERT_TRUE(g.add_tracked_edge("tracker_base", "head", id));
+  TrackedTransform r = report(id, pose(0, 0.5, 0.6, 0, 0, 0), covariance(1e-3, 1e-3, 3), kT0);
+  r.parent_frame = "world";
+  const auto mismatch = g.frame_mismatch(r);
+  ASSERT_TRUE(mismatch);
+  EXPECT_NE(mismatch->find("'world'"), std::string::npos) << *mismatch;
+  EXPECT_NE(mismatch->find("'tracker_base'"), std::string::npos) << *mismatch;
+  EXPECT_NE(mismatch->find("optical/head"), std::string::npos) << *mismatch;
+  const auto refused = g.update(id, r);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().message, *mismatch);
+  EXPECT_TRUE(g.query("world", "head", kT0)->unbounded);  // not stored
+  r.parent_frame = "tracker_base";
+  EXPECT_FALSE(g.frame_mismatch(r));
+  ASSERT_TRUE(g.update(id, r));
+  EXPECT_FALSE(g.query("world", "head", kT0)->unbounded);
+  r.parent_frame.clear();  // a report that names no frame is taken as it is
+  EXPECT_FALSE(g.frame_mismatch(r));
+}
+
 TEST(TransformGraph, RejectsCyclesSecondParentsAndUnknownFrames) {
   TransformGraph g;
   ASSERT_TRUE(g.add_static_edge("a", "b", Pose::Identity()));

@@ -1,12 +1,16 @@
 // Razer Hydra: the report parser on reports built from the documented format, the
-// hemisphere resolution, the mode-switch feature reports, and a clear error without one.
+// hemisphere resolution, the mode-switch feature reports, the plausibility gate on
+// reports with magnetic glitches, and a clear error without a device.
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
+#include <random>
 
 #include "capture_sink.hpp"
 #include "covtrack/devices/hydra/hydra_driver.hpp"
 #include "covtrack/devices/hydra/hydra_report.hpp"
+#include "covtrack/devices/hydra/hydra_stream.hpp"
 
 using namespace covtrack;
 using namespace covtrack::hydra;
@@ -104,4 +108,102 @@ TEST(HydraDriver, DefaultCovarianceIsTheStatedAccuracy) {
   EXPECT_NEAR(std::sqrt(c(0, 0)), 1e-3, 1e-12);
   EXPECT_NEAR(std::sqrt(c(5, 5)) * 180 / 3.141592653589793, 1.0, 1e-9);
   EXPECT_EQ(c(0, 1), 0);
+}
+
+namespace {
+
+// Two hands swaying at 0.7 and 1.1 Hz, 5 cm and 0.3 rad, at 250 reports per second.
+Pose swaying_hand(int controller, double t) {
+  const double f = controller == 0 ? 0.7 : 1.1, side = controller == 0 ? -0.25 : 0.25;
+  const double w = 2 * 3.141592653589793 * f;
+  const Vec3 p(side + 0.05 * std::sin(w * t), 0.1 + 0.03 * std::cos(w * t), -0.3 + 0.02 * std::sin(2 * w * t));
+  return pose_from(p, Eigen::Quaterniond(Eigen::AngleAxisd(0.3 * std::sin(w * t), Vec3(0, 1, 0))));
+}
+
+struct GlitchRun {
+  int published = 0, dropped = 0, degraded = 0, outside = 0;
+};
+
+// Reports of the swaying hands, with `glitch_every`-th report of controller 0 moved by
+// `glitch_m` (0: none); each published pose is checked against the true one (the
+// report's 1 mm quantisation is within the default covariance).
+GlitchRun run_with_glitches(int glitch_every, double glitch_m) {
+  HydraConfig c;
+  c.device = "hydra";
+  c.covariance = hydra_default_covariance();
+  HydraStream stream(c);
+  GlitchRun run;
+  const std::int64_t period_us = 4000;
+  for (int k = 0; k < 2500; ++k) {
+    const double t = k * period_us * 1e-6;
+    HydraReport report;
+    for (int i = 0; i < 2; ++i) {
+      const Pose truth = swaying_hand(i, t);
+      report.controllers[i].position_m = truth.translation();
+      report.controllers[i].orientation = Eigen::Quaterniond(truth.rotation());
+    }
+    if (glitch_every > 0 && k > 10 && k % glitch_every == 0) report.controllers[0].position_m.z() += glitch_m;
+    auto parsed = parse_hydra_report(build_hydra_report(report));
+    EXPECT_TRUE(parsed);
+    const auto out = stream.on_report(*parsed, 1'000'000 + k * period_us);
+    run.dropped += static_cast<int>(out.errors.size());
+    for (const auto& s : out.samples) {
+      ++run.published;
+      run.degraded += s.status == TrackingStatus::Degraded;
+      const Vec6 e = boxminus(swaying_hand(s.sensor == "left" ? 0 : 1, t), s.T_parent_child);
+      run.outside += e.dot(s.covariance.ldlt().solve(e)) > 22.458;  // chi2(6) 99.9 %
+    }
+  }
+  return run;
+}
+
+}  // namespace
+
+TEST(HydraStream, CleanHandsLoseNothingToTheGate) {
+  const GlitchRun run = run_with_glitches(0, 0);
+  std::printf("clean: %d published, %d dropped, %d DEGRADED, %d outside their 99.9%% region\n", run.published,
+              run.dropped, run.degraded, run.outside);
+  EXPECT_EQ(run.dropped, 0);
+  EXPECT_GE(run.published, 2 * 2500 - 2);  // only each stream's first report is held
+  EXPECT_LE(run.degraded, run.published / 100);
+  EXPECT_LE(run.outside, run.published / 1000);
+}
+
+TEST(HydraStream, MagneticJumpsAreDroppedOrCovered) {
+  // 30 cm in one report: faster than any hand (75 m/s); dropped.
+  GlitchRun run = run_with_glitches(50, 0.3);
+  std::printf("30 cm jumps: %d published, %d dropped, %d DEGRADED, %d outside\n", run.published, run.dropped,
+              run.degraded, run.outside);
+  EXPECT_GE(run.dropped, 2500 / 50 - 2);
+  EXPECT_LE(run.outside, run.published / 1000);
+  // 2 cm in one report: possible for a hand (5 m/s) but 20 sigma from the prediction;
+  // published DEGRADED with a covariance that covers it, or dropped.
+  run = run_with_glitches(50, 0.02);
+  std::printf("2 cm jumps: %d published, %d dropped, %d DEGRADED, %d outside\n", run.published, run.dropped,
+              run.degraded, run.outside);
+  EXPECT_GE(run.dropped + run.degraded, 2500 / 50 - 2);
+  EXPECT_LE(run.outside, run.published / 1000);
+}
+
+TEST(HydraStream, LostRestartsTheGate) {
+  HydraConfig c;
+  c.device = "hydra";
+  c.covariance = hydra_default_covariance();
+  HydraStream stream(c);
+  HydraReport report;
+  report.controllers[0].position_m = Vec3(-0.2, 0, -0.3);
+  report.controllers[1].position_m = Vec3(0.2, 0, -0.3);
+  EXPECT_TRUE(stream.on_report(report, 1'000'000).samples.empty());  // held
+  EXPECT_EQ(stream.on_report(report, 1'004'000).samples.size(), 2u);
+  const auto lost = stream.lost(2'000'000);
+  ASSERT_EQ(lost.size(), 2u);
+  EXPECT_EQ(lost[0].status, TrackingStatus::Lost);
+  EXPECT_TRUE(std::isinf(lost[0].covariance(0, 0)));
+  EXPECT_NEAR(lost[0].T_parent_child.translation().x(), -0.2, 1e-12);
+  // Back 1 m away: a fresh start, not a jump.
+  report.controllers[0].position_m = Vec3(-0.2, 1.0, -0.3);
+  EXPECT_TRUE(stream.on_report(report, 3'000'000).samples.empty());
+  const auto out = stream.on_report(report, 3'004'000);
+  EXPECT_EQ(out.samples.size(), 2u);
+  EXPECT_TRUE(out.errors.empty());
 }

@@ -14,6 +14,7 @@
 #include <Eigen/Cholesky>
 
 #include "covtrack/devices/lenz/dead_reckoning.hpp"
+#include "covtrack/devices/lenz/feedback_confirmation.hpp"
 #include "covtrack/devices/lenz/layout_config.hpp"
 #include "covtrack/devices/lenz/lenz_config.hpp"
 #include "covtrack/devices/lenz/train_poses.hpp"
@@ -255,6 +256,73 @@ TEST(LenzDeadReckoning, FirstReportStopsAndLossAreHandled) {
   occ[7] = false;
   r.on_occupancy(occ, 62.0);
   EXPECT_EQ(r.estimate(62.0).state, AlongTrack::State::Lost);
+}
+
+namespace {
+
+// A feedback pair for one nibble of an RS-bus module (inputs as bits, input 1 or 5 first).
+FeedbackPair nibble_pair(int module, bool upper, std::uint8_t bits) {
+  return {static_cast<std::uint8_t>(module - 1), static_cast<std::uint8_t>(0x40 | (upper ? 0x10 : 0) | bits)};
+}
+
+}  // namespace
+
+// The short layout: sections 0-7 are inputs 65:1-8, sections 8-9 are 66:1-2.
+TEST(LenzFeedbackConfirmation, ImpossibleChangesAreHeldUntilAskedAgain) {
+  const TrackLayout layout = load("tests/data/lenz_short_layout.toml");
+  DeadReckoner r(layout, {0.05});
+  FeedbackConfirmation fc(layout, 1.0);
+  const auto step = [&](const Feedback& fb, double t) {
+    auto o = fc.apply(fb, r, t);
+    if (o.changed) r.on_occupancy(section_occupancy(layout, fc.state()), t);
+    return o;
+  };
+  // Startup answers: section 0 occupied. Nothing to protect yet: applied at once.
+  auto o = step({{nibble_pair(65, false, 0b0001), nibble_pair(65, true, 0), nibble_pair(66, false, 0),
+                  nibble_pair(66, true, 0)}}, 0.0);
+  EXPECT_TRUE(o.changed);
+  EXPECT_TRUE(o.ask.empty());
+  EXPECT_EQ(r.estimate(0.0).section, 0u);
+  // Crossing ahead into section 1: applied at once.
+  o = step({{nibble_pair(65, false, 0b0010)}}, 1.0);
+  EXPECT_TRUE(o.changed);
+  EXPECT_TRUE(o.ask.empty());
+  EXPECT_EQ(r.estimate(1.0).section, 1u);
+  EXPECT_EQ(r.estimate(1.0).state, AlongTrack::State::DeadReckoning);
+  // A forged report: section 6 (65:7) occupied, section 1 clear. Held and asked for.
+  o = step({{nibble_pair(65, true, 0b0100), nibble_pair(65, false, 0)}}, 1.2);
+  EXPECT_FALSE(o.changed);
+  ASSERT_EQ(o.ask.size(), 2u);
+  EXPECT_EQ(o.ask[0].address, 64);
+  EXPECT_EQ(fc.held(), 2u);
+  EXPECT_EQ(r.estimate(1.2).section, 1u);
+  EXPECT_EQ(r.inconsistencies(), 0u);
+  // The answers repeat the true inputs: both dropped as noise, nothing changed.
+  o = step({{nibble_pair(65, false, 0b0010)}}, 1.21);
+  EXPECT_FALSE(o.changed);
+  EXPECT_EQ(o.dropped.size(), 1u);
+  o = step({{nibble_pair(65, true, 0)}}, 1.22);
+  EXPECT_EQ(o.dropped.size(), 1u);
+  EXPECT_NE(o.dropped[0].find("feedback module 65 inputs 5-8"), std::string::npos) << o.dropped[0];
+  EXPECT_EQ(fc.held(), 0u);
+  EXPECT_EQ(r.estimate(1.3).state, AlongTrack::State::DeadReckoning);
+  // A true jump (a crossing was missed): confirmed by the answer, then believed.
+  o = step({{nibble_pair(65, false, 0b1000)}}, 2.0);  // section 3 alone
+  EXPECT_FALSE(o.changed);
+  EXPECT_EQ(o.ask.size(), 1u);
+  o = step({{nibble_pair(65, false, 0b1000)}}, 2.03);
+  EXPECT_TRUE(o.changed);
+  EXPECT_EQ(r.estimate(2.03).section, 3u);
+  EXPECT_EQ(r.estimate(2.03).state, AlongTrack::State::WholeSection);
+  EXPECT_EQ(r.inconsistencies(), 1u);
+  // A vanished train is held too; unanswered, it is dropped after the timeout.
+  o = step({{nibble_pair(65, false, 0)}}, 3.0);
+  EXPECT_EQ(o.ask.size(), 1u);
+  EXPECT_TRUE(fc.expire(3.5).dropped.empty());
+  o = fc.expire(4.01);
+  ASSERT_EQ(o.dropped.size(), 1u);
+  EXPECT_NE(o.dropped[0].find("within 1.0 s"), std::string::npos) << o.dropped[0];
+  EXPECT_EQ(r.estimate(4.01).section, 3u);
 }
 
 TEST(LenzPoseModel, LostIsInfiniteAndDegradedIsAValidCovariance) {

@@ -55,7 +55,7 @@ using LatestReport = std::function<std::optional<client::TrackedTransform>(const
 
 // One line per tracked transform: where its value comes from and how old it is.
 std::vector<std::string> legend_lines(const RegionsModel& model, const LatestReport& latest_report,
-                                      std::int64_t now) {
+                                      const FrameMismatches& mismatches, std::int64_t now) {
   std::vector<std::string> lines = {
       fmt::format("{:.0f}% regions: ellipses blue, outer green, inner white", 100 * model.confidence)};
   for (const scene::SceneTransform& t : model.scene.transforms) {
@@ -65,6 +65,8 @@ std::vector<std::string> legend_lines(const RegionsModel& model, const LatestRep
       const auto latest = latest_report(*t.stream);
       state = latest ? fmt::format("{} {:.0f} ms old", to_string(latest->status), latest->age_s(now) * 1e3)
                      : std::string("no report: LOST");
+      if (const auto parent = mismatches.reported_parent(*t.stream))
+        state = fmt::format("not used: reports in frame '{}', not '{}'", *parent, t.parent);
     }
     lines.push_back(fmt::format("{} -> {} [{}]: {}", t.parent, t.child, t.stream->key(), state));
   }
@@ -110,6 +112,7 @@ int run_view(const ViewArgs& args) {
   std::unique_ptr<client::Subscriber> subscriber;
   std::optional<LogFollower> log;
   LatestReport latest_report;  // none: the scene's fixed values
+  FrameMismatches mismatches;
   const bool fixed = !args.live && args.log_path.empty();
   const std::optional<std::int64_t> fixed_at =
       fixed ? std::optional<std::int64_t>(covtrack::now_us()) : std::nullopt;
@@ -120,7 +123,7 @@ int run_view(const ViewArgs& args) {
     if (!sub) return fail_with(sub.error().message, 2);
     subscriber = std::move(*sub);
     // Streams the scene does not use are simply not in the graph.
-    (void)subscriber->on_pose(".*", [&graph](const client::TrackedTransform& t) { (void)graph.update(t.stream, t); });
+    (void)subscriber->on_pose(".*", [&](const client::TrackedTransform& t) { mismatches.update(graph, t); });
     latest_report = [&subscriber](const StreamId& id) { return subscriber->latest(id); };
   }
   if (!args.log_path.empty()) {
@@ -169,7 +172,7 @@ int run_view(const ViewArgs& args) {
     const std::optional<std::int64_t> log_time =
         log ? std::optional<std::int64_t>(log->start_us() + std::llround(elapsed_s * args.speed * 1e6))
             : std::nullopt;
-    if (log) log->advance_to(*log_time, graph);
+    if (log) log->advance_to(*log_time, graph, mismatches);
     const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s - 1e-9) ||
                       (log && log->finished());
     // Fixed scene values are as fresh as when they were set: no staleness grows on them.
@@ -193,7 +196,7 @@ int run_view(const ViewArgs& args) {
       std::cerr << "covtrack view: " << warning << "\n";
       warning.clear();
     }
-    auto lines = legend_lines(*model, latest_report, now);
+    auto lines = legend_lines(*model, latest_report, mismatches, now);
     if (const std::string line = selection_line(*report, widget_frame); !line.empty()) lines.push_back(line);
     draw_regions(image, *report, &widget_frame, legend_height_px(lines.size(), image.rows));
     draw_legend(image, lines);

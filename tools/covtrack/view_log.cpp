@@ -19,14 +19,14 @@ Result<LogFollower> LogFollower::open(const std::string& path) {
   return follower;
 }
 
-void LogFollower::advance_to(std::int64_t log_time_us, client::TransformGraph& graph) {
+void LogFollower::advance_to(std::int64_t log_time_us, client::TransformGraph& graph, FrameMismatches& mismatches) {
   while (pending_ && pending_->timestamp_us <= log_time_us) {
-    feed(*pending_, graph);
+    feed(*pending_, graph, mismatches);
     pending_ = reader_.next();
   }
 }
 
-void LogFollower::feed(const lcmlog::LogEvent& event, client::TransformGraph& graph) {
+void LogFollower::feed(const lcmlog::LogEvent& event, client::TransformGraph& graph, FrameMismatches& mismatches) {
   if (event.channel.starts_with(kImagePrefix)) return keep_image(event);
   if (!event.channel.starts_with(kPosePrefix)) return;  // raw bytes, truth, heartbeats: not for the view
   const std::string channel(event.channel);
@@ -35,7 +35,7 @@ void LogFollower::feed(const lcmlog::LogEvent& event, client::TransformGraph& gr
   if (auto invalid = client::rejection_reason(*msg)) return rejections_.add("invalid pose", channel, *invalid);
   client::TrackedTransform t = client::to_tracked_transform(*msg, event.timestamp_us);
   latest_[t.stream.key()] = t;
-  (void)graph.update(t.stream, t);  // streams the scene does not use are not in the graph
+  mismatches.update(graph, t);
 }
 
 // Kept encoded: most frames of a fast replay are overtaken before they are drawn.

@@ -19,6 +19,7 @@
 #include "covtrack/lcmlog/log_reader.hpp"
 #include "covtrack/protocol/rejection_tally.hpp"
 #include "covtrack/protocol/result.hpp"
+#include "frame_mismatches.hpp"
 
 namespace covtrack::cli {
 
@@ -26,8 +27,9 @@ class LogFollower {
  public:
   static Result<LogFollower> open(const std::string& path);
 
-  // Feeds every pose event with timestamp <= log_time_us into the graph.
-  void advance_to(std::int64_t log_time_us, client::TransformGraph& graph);
+  // Feeds every pose event with timestamp <= log_time_us into the graph (refusals of
+  // reports in another parent frame are told through `mismatches`).
+  void advance_to(std::int64_t log_time_us, client::TransformGraph& graph, FrameMismatches& mismatches);
 
   std::int64_t start_us() const { return start_us_; }
   bool finished() const { return !pending_; }
@@ -44,7 +46,7 @@ class LogFollower {
 
  private:
   explicit LogFollower(lcmlog::LogReader reader) : reader_(std::move(reader)) {}
-  void feed(const lcmlog::LogEvent& event, client::TransformGraph& graph);
+  void feed(const lcmlog::LogEvent& event, client::TransformGraph& graph, FrameMismatches& mismatches);
   void keep_image(const lcmlog::LogEvent& event);
   bool decode_frame(const std::vector<std::byte>& payload, std::int64_t time_us, std::string& warning);
 

@@ -4,6 +4,7 @@
 
 #include "covtrack/devices/covariance_keys.hpp"
 #include "covtrack/devices/device_keys.hpp"
+#include "covtrack/devices/motion_limit_keys.hpp"
 #include "covtrack/devices/valid_frame_watchdog.hpp"
 #include "covtrack/devices/hydra/hydra_driver.hpp"
 #include "covtrack/protocol/channels.hpp"
@@ -32,6 +33,7 @@ const TableSpec& hydra_device_spec() {
                             "switch is repeated every 2 s meanwhile"),
     };
     s.keys.insert(s.keys.end(), own.begin(), own.end());
+    for (const auto& k : motion_limit_keys()) s.keys.push_back(k);
     for (auto k : covariance_keys()) {
       k.default_value = "1 mm, 1 degree";
       s.keys.push_back(k);
@@ -58,6 +60,7 @@ HydraConfig read_hydra_config(TableReader& r, const std::string& name) {
   c.no_valid_frames_s = r.number(kNoValidFramesKey, c.no_valid_frames_s);
   const bool given = r.has("covariance") || r.has("sigma_m") || r.has("sigma_rad");
   c.covariance = given ? read_covariance(r) : hydra_default_covariance();
+  c.motion = read_motion_limits(r);
   return c;
 }
 

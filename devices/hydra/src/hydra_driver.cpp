@@ -1,13 +1,13 @@
 #include "covtrack/devices/hydra/hydra_driver.hpp"
 
 #include <chrono>
-#include <limits>
 
 #include <fmt/format.h>
 #include <hidapi/hidapi.h>
 
 #include "covtrack/devices/file_kind.hpp"
 #include "covtrack/devices/hydra/hydra_report.hpp"
+#include "covtrack/devices/hydra/hydra_stream.hpp"
 #include "covtrack/devices/valid_frame_watchdog.hpp"
 #include "covtrack/protocol/clock.hpp"
 
@@ -90,32 +90,19 @@ class HydraDriver final : public Driver {
       last_report = Clock::now();
       watchdog.valid_frame(last_report);
       lost = false;
-      const std::int64_t t = now_us();
-      for (int i = 0; i < 2; ++i) {
-        const auto& c = report->controllers[static_cast<std::size_t>(i)];
-        PoseSample s{config_.sensors[i], config_.parent_frame, config_.sensors[i], t};
-        s.T_parent_child = pose_from(hemisphere_.resolve(i, c.position_m), c.orientation);
-        s.covariance = config_.covariance;
-        last_[i] = s.T_parent_child;
-        sink.pose(s);
-      }
+      auto out = stream_.on_report(*report, now_us());
+      for (const auto& line : out.errors) sink.count_error(line);
+      for (const auto& sample : out.samples) sink.pose(sample);
     }
     return {};
   }
 
   void report_lost(SampleSink& sink) {
-    for (int i = 0; i < 2; ++i) {
-      PoseSample s{config_.sensors[i], config_.parent_frame, config_.sensors[i], now_us()};
-      s.status = TrackingStatus::Lost;
-      s.T_parent_child = last_[i];
-      s.covariance = Mat6::Identity() * std::numeric_limits<double>::infinity();
-      sink.pose(s);
-    }
+    for (const auto& sample : stream_.lost(now_us())) sink.pose(sample);
   }
 
   HydraConfig config_;
-  HemisphereTracker hemisphere_;
-  std::array<Pose, 2> last_ = {Pose::Identity(), Pose::Identity()};
+  HydraStream stream_{config_};
 };
 
 }  // namespace

@@ -17,6 +17,24 @@ void DeadReckoner::reset() {
 
 void DeadReckoner::lose() { reset(); }
 
+DeadReckoner::Move DeadReckoner::classify(const std::vector<bool>& occ) const {
+  const auto count = std::count(occ.begin(), occ.end(), true);
+  const std::size_t here = *section_;
+  const std::size_t ahead = direction_ > 0 ? layout_.next(here) : layout_.previous(here);
+  const std::size_t behind = direction_ > 0 ? layout_.previous(here) : layout_.next(here);
+  // Crossed into the section ahead (the one left may still read occupied for a moment).
+  if (occ[ahead] && (count == 1 || (count == 2 && occ[here]))) return Move::Ahead;
+  // Still here, possibly with the rear pickups still on the section just left.
+  if (occ[here] && (count == 1 || (count == 2 && occ[behind]))) return Move::Stay;
+  // Went back into the section behind: only a train that may reverse does that.
+  if (layout_.train().reversible && occ[behind] && count == 1) return Move::Behind;
+  return Move::Impossible;  // a skipped section, a jump, a move backwards, a vanished train
+}
+
+bool DeadReckoner::is_possible_move(const std::vector<bool>& occupied) const {
+  return !section_ || classify(occupied) != Move::Impossible;
+}
+
 void DeadReckoner::on_occupancy(const std::optional<std::vector<bool>>& occupied, double t_s) {
   if (!occupied) return lose();
   const auto& occ = *occupied;
@@ -24,17 +42,15 @@ void DeadReckoner::on_occupancy(const std::optional<std::vector<bool>>& occupied
   if (count == 0) return lose();
   if (section_) {
     const std::size_t here = *section_;
-    const std::size_t ahead = direction_ > 0 ? layout_.next(here) : layout_.previous(here);
-    const std::size_t behind = direction_ > 0 ? layout_.previous(here) : layout_.next(here);
-    // Crossed into the section ahead (the one left may still read occupied for a moment).
-    if (occ[ahead] && (count == 1 || (count == 2 && occ[here]))) return enter(ahead, direction_, t_s);
-    // Still here, possibly with the rear pickups still on the section just left.
-    if (occ[here] && (count == 1 || (count == 2 && occ[behind]))) return;
-    // Went back into the section behind: only a train that may reverse does that.
-    if (layout_.train().reversible && occ[behind] && count == 1) return enter(behind, -direction_, t_s);
+    switch (classify(occ)) {
+      case Move::Ahead: return enter(direction_ > 0 ? layout_.next(here) : layout_.previous(here), direction_, t_s);
+      case Move::Stay: return;
+      case Move::Behind: return enter(direction_ > 0 ? layout_.previous(here) : layout_.next(here), -direction_, t_s);
+      case Move::Impossible: break;
+    }
   }
-  // First report, or a pattern the train cannot produce from where we thought it was
-  // (a skipped section, a jump, a move backwards): start again from what is occupied.
+  // First report, or a pattern the train cannot produce from where we thought it was:
+  // start again from what is occupied.
   if (section_) ++inconsistencies_;
   reset();
   if (count == 1) section_ = static_cast<std::size_t>(std::find(occ.begin(), occ.end(), true) - occ.begin());

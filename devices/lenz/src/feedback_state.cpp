@@ -26,6 +26,11 @@ std::optional<bool> FeedbackState::input(int module, int input) const {
   return ((inputs_[address] >> (input - 1)) & 1) != 0;
 }
 
+std::optional<std::uint8_t> FeedbackState::nibble(std::uint8_t address, bool upper) const {
+  if (address >= inputs_.size() || !(known_[address] & (upper ? 2 : 1))) return std::nullopt;
+  return static_cast<std::uint8_t>((upper ? inputs_[address] >> 4 : inputs_[address]) & 0x0F);
+}
+
 void FeedbackState::reset() {
   inputs_.fill(0);
   known_.fill(0);

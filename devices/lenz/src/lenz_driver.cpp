@@ -3,11 +3,12 @@
 #include <chrono>
 #include <optional>
 #include <set>
+#include <utility>
 
 #include <fmt/format.h>
 
 #include "covtrack/devices/interruptible_sleep.hpp"
-#include "covtrack/devices/lenz/feedback_state.hpp"
+#include "covtrack/devices/lenz/feedback_confirmation.hpp"
 #include "covtrack/devices/lenz/xpressnet_framing.hpp"
 #include "covtrack/devices/lenz/xpressnet_messages.hpp"
 #include "covtrack/devices/serial/serial_port.hpp"
@@ -29,12 +30,20 @@ struct overloaded : F... {
 
 double now_s() { return static_cast<double>(now_us()) * 1e-6; }
 
+// A held feedback change (feedback_confirmation.hpp) is asked for again at once; an
+// interface answers within tens of milliseconds, so one not confirmed in this long is
+// dropped.
+constexpr double kConfirmTimeout_s = 1.0;
+
 Clock::duration seconds(double s) { return duration_cast<Clock::duration>(duration<double>(s)); }
 
 class LenzDriver final : public Driver {
  public:
   explicit LenzDriver(const LenzConfig& config)
-      : config_(config), reckoner_(*config.layout, config.reckoning), period_(seconds(1.0 / config.rate_hz)) {}
+      : config_(config),
+        reckoner_(*config.layout, config.reckoning),
+        feedback_(*config.layout, kConfirmTimeout_s),
+        period_(seconds(1.0 / config.rate_hz)) {}
 
   Result<void> run(SampleSink& sink, std::stop_token stop) override {
     bool connected_before = false;
@@ -58,6 +67,7 @@ class LenzDriver final : public Driver {
       // Crossings may be missed while the link is down: start the estimate afresh.
       reckoner_.reset();
       feedback_.reset();
+      to_ask_.clear();
       decoder_.reset();
     }
     return {};
@@ -93,6 +103,8 @@ class LenzDriver final : public Driver {
           bytes_since_reply = 0;
         }
       }
+      take(feedback_.expire(now_s()), sink);
+      if (auto sent = ask_held(port, sink); !sent) return sent;
       if (now - last_rx > seconds(config_.link_timeout_s))
         return fail(fmt::format("serial port {}: interface silent for {:.1f} s (no reply to the status request)",
                                 config_.port, duration<double>(now - last_rx).count()));
@@ -135,6 +147,20 @@ class LenzDriver final : public Driver {
     return port.write_all(bytes, milliseconds(80));
   }
 
+  // Acts on what the feedback reports did: re-runs the reckoner on a change, counts
+  // changes dropped as noise, and keeps the nibbles to ask for again (sent by ask_held).
+  void take(const FeedbackConfirmation::Outcome& outcome, SampleSink& sink) {
+    if (outcome.changed) reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_.state()), now_s());
+    for (const auto& line : outcome.dropped) sink.count_error(fmt::format("{}: {}", config_.port, line));
+    to_ask_.insert(to_ask_.end(), outcome.ask.begin(), outcome.ask.end());
+  }
+
+  Result<void> ask_held(serial::SerialPort& port, SampleSink& sink) {
+    for (const auto& request : std::exchange(to_ask_, {}))
+      if (auto sent = send(port, sink, request); !sent) return sent;
+    return {};
+  }
+
   // Returns whether a status reply came (the sign of life; see session()).
   bool handle_bytes(std::span<const std::uint8_t> bytes, SampleSink& sink) {
     bool status_reply = false;
@@ -147,9 +173,7 @@ class LenzDriver final : public Driver {
     }
     for (const auto& frame : frames) {
       std::visit(overloaded{
-                     [&](const Feedback& fb) {
-                       if (feedback_.apply(fb)) reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_), now_s());
-                     },
+                     [&](const Feedback& fb) { take(feedback_.apply(fb, reckoner_, now_s()), sink); },
                      [&](const InterfaceNotice& n) {
                        if (n.code != 0x04 && n.code != 0x07) sink.count_error(describe_notice(n.code));
                      },
@@ -178,7 +202,8 @@ class LenzDriver final : public Driver {
 
   LenzConfig config_;
   DeadReckoner reckoner_;
-  FeedbackState feedback_;
+  FeedbackConfirmation feedback_;
+  std::vector<FeedbackRequest> to_ask_;
   FrameDecoder decoder_;
   Clock::duration period_;
   Clock::time_point next_sample_;

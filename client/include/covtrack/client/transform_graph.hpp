@@ -87,8 +87,15 @@ class TransformGraph {
 
   // Stores the latest report of a stream (for every edge bound to it). A report measured
   // before the stored one is ignored (out-of-order delivery). Fails if no edge is bound to
-  // the stream. Ready for Subscriber::on_pose: [&](auto& t) { (void)graph.update(t.stream, t); }
+  // the stream, or if the report is in another parent frame than the edge's (see
+  // frame_mismatch): such a report is not stored. Ready for Subscriber::on_pose:
+  // [&](auto& t) { (void)graph.update(t.stream, t); }
   Result<void> update(const StreamId& stream, const TrackedTransform& report);
+  // Why a report of a bound stream cannot be used: it gives its pose relative to another
+  // frame than the one the graph attaches it to (a device configured with another
+  // parent_frame than the scene expects). Both names are in the message. Nothing when it
+  // fits, when the report names no parent frame, or when no edge is bound to the stream.
+  std::optional<std::string> frame_mismatch(const TrackedTransform& report) const;
   // The same for the tracked edge whose child frame is `edge_child_frame`; fails for an
   // unknown frame, a static edge or a combined edge (update those by stream).
   Result<void> update(const std::string& edge_child_frame, const TrackedTransform& report);
@@ -122,6 +129,7 @@ class TransformGraph {
 
   Result<void> add_edge(const std::string& parent, const std::string& child, Edge edge);
   Result<void> store_report(const StreamId& stream, const TrackedTransform& report);
+  std::optional<std::string> mismatch_of(const StreamId& stream, const TrackedTransform& report) const;
   std::optional<FrameIndex> find(const std::string& frame) const;
   FrameIndex add_frame(const std::string& frame);  // a new root
   FrameIndex tree_of(FrameIndex frame);
@@ -138,6 +146,7 @@ class TransformGraph {
   // made a long chain quadratic to load.
   std::vector<FrameIndex> tree_;
   std::unordered_map<std::string, int> bound_streams_;     // StreamId::key() -> tracked sources
+  std::unordered_map<std::string, std::string> stream_parent_;  // StreamId::key() -> its edge's parent
   std::map<std::string, TrackedTransform> latest_;         // by StreamId::key()
 };
 

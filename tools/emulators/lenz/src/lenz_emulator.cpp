@@ -117,6 +117,11 @@ void LenzEmulator::update_occupancy(double s) {
   }
 }
 
+void LenzEmulator::forge_feedback(const FeedbackPair& pair) {
+  std::lock_guard lock(forged_mutex_);
+  forged_.push_back(pair);
+}
+
 void LenzEmulator::publish_truth(const std::function<void(const TruthSample&)>& truth, std::int64_t time_us,
                                  double s) {
   const auto& train = options_.layout->train();
@@ -147,6 +152,13 @@ void LenzEmulator::run(std::stop_token stop, const std::function<void(const Trut
     } else {
       std::this_thread::sleep_for(tick);
     }
+    std::vector<FeedbackPair> forged;
+    {
+      std::lock_guard lock(forged_mutex_);
+      forged.swap(forged_);
+    }
+    for (const auto& pair : forged)
+      if (pty_.plugged()) send(Feedback{{pair}}, Prefix::Unsolicited);
     const std::int64_t t_us = now_us();
     const double s = true_s_at(t_us);
     update_occupancy(s);

@@ -9,6 +9,7 @@
 
 #include "covtrack/devices/config_reader.hpp"
 #include "covtrack/devices/driver.hpp"
+#include "covtrack/devices/motion_gate.hpp"
 
 namespace covtrack::hydra {
 
@@ -22,6 +23,7 @@ struct HydraConfig {
   double watchdog_periods = 4;
   // No report that parses for this long, whatever the base sends: FAILED, restarted.
   double no_valid_frames_s = 10;
+  MotionLimits motion;  // the plausibility gate (hydra_stream.hpp)
 };
 
 // The default covariance: Sixense/Razer state 1 mm position and 1 degree orientation.

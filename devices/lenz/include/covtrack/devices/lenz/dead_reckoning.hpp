@@ -46,6 +46,10 @@ class DeadReckoner {
   // The occupied state of every section (index as in the layout), after any change;
   // nothing when some section's input is not known yet.
   void on_occupancy(const std::optional<std::vector<bool>>& occupied, double t_s);
+  // Whether the train can have produced this occupancy from where it is thought to be
+  // (crossed ahead, stayed, or backed up if it may); true while there is no estimate.
+  // A pattern it cannot produce is either missed crossings or a corrupt report.
+  bool is_possible_move(const std::vector<bool>& occupied) const;
   AlongTrack estimate(double t_s) const;
   // Forget everything (after a reconnect: crossings may have been missed).
   void reset();
@@ -54,6 +58,8 @@ class DeadReckoner {
 
  private:
   struct SpeedRange { double lo = 0, hi = 0; };
+  enum class Move { Ahead, Stay, Behind, Impossible };
+  Move classify(const std::vector<bool>& occupied) const;  // requires section_
   SpeedRange speed_after(std::size_t section, double traversal_s, bool same_direction) const;
   void enter(std::size_t section, int direction, double t_s);
   void lose();

@@ -18,6 +18,8 @@ class FeedbackState {
   bool apply(const Feedback& feedback);
   // Input 1-8 of RS-bus module 1-128: occupied or not, nothing while its nibble is unknown.
   std::optional<bool> input(int module, int input) const;
+  // Inputs 1-4 (or 5-8) of the module at this wire address, as reported (bit 0 first).
+  std::optional<std::uint8_t> nibble(std::uint8_t address, bool upper) const;
   void reset();
 
  private:

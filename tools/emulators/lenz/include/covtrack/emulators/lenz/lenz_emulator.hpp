@@ -10,8 +10,10 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <stop_token>
 #include <string>
+#include <vector>
 
 #include "covtrack/devices/driver.hpp"
 #include "covtrack/devices/lenz/lenz_config.hpp"
@@ -54,6 +56,9 @@ class LenzEmulator {
   // Thread-safe: the running loop closes (unplug) or recreates (replug) the terminal.
   void unplug() { want_plugged_ = false; }
   void replug() { want_plugged_ = true; }
+  // Thread-safe: sends a feedback broadcast that is not true, as line noise whose XOR
+  // byte happens to check would (the running loop writes it).
+  void forge_feedback(const FeedbackPair& pair);
   std::uint64_t requests_answered() const { return requests_answered_; }
   std::uint64_t broadcasts_sent() const { return broadcasts_sent_; }
 
@@ -75,6 +80,8 @@ class LenzEmulator {
   std::atomic<bool> want_plugged_{true};
   std::atomic<std::uint64_t> requests_answered_{0}, broadcasts_sent_{0};
   bool track_power_ = true;
+  std::mutex forged_mutex_;
+  std::vector<FeedbackPair> forged_;
 };
 
 }  // namespace covtrack::lenz
