@@ -19,10 +19,12 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Tracker daemon publishing poses with 6x6 
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGE_DIRECTORY ${PROJECT_BINARY_DIR}/packages)
 set(CPACK_GENERATOR DEB)
-set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
-# Install with DESTDIR and the real prefix, so that packaging/install_service.cmake sees
-# /usr and puts the config in /etc.
+# Install with DESTDIR and the real prefix (CPACK_INSTALL_PREFIX, whatever the build's
+# CMAKE_INSTALL_PREFIX), so that packaging/install_service.cmake sees /usr and puts the
+# config in /etc.
 set(CPACK_SET_DESTDIR ON)
+set(CPACK_INSTALL_PREFIX /usr)
+set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 # Programs without their debug information (-g): some 100 MB each with it. Static
 # libraries keep their symbols (CMake never strips them).
 set(CPACK_STRIP_FILES ON)
