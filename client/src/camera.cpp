@@ -1,6 +1,8 @@
 #include "covtrack/client/camera.hpp"
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
@@ -40,6 +42,23 @@ Mat2 Camera::intrinsic_covariance_at(const Vec2& pixel) const {
 
 namespace {
 
+// A ROS camera_info matrix: {rows, cols, data: [...]} without OpenCV's type tag.
+Result<cv::Mat> read_untagged_matrix(const cv::FileNode& node, const std::string& file, const char* key) {
+  const cv::FileNode data = node["data"];
+  if (!data.isSeq()) return fail(fmt::format("{}: key '{}' is not a matrix (no data list)", file, key));
+  cv::Mat m(static_cast<int>(data.size()), 1, CV_64F);
+  for (int i = 0; i < m.rows; ++i) {
+    const cv::FileNode v = data[i];
+    if (!v.isReal() && !v.isInt()) return fail(fmt::format("{}: key '{}': data entry {} is not a number", file, key, i));
+    m.at<double>(i) = static_cast<double>(v);
+  }
+  const cv::FileNode rows = node["rows"], cols = node["cols"];
+  if (rows.isInt() && cols.isInt() && static_cast<int>(rows) * static_cast<int>(cols) != m.rows)
+    return fail(fmt::format("{}: key '{}': {} x {} matrix with {} data entries", file, key, static_cast<int>(rows),
+                            static_cast<int>(cols), m.rows));
+  return m;
+}
+
 Result<cv::Mat> read_matrix(const cv::FileStorage& fs, const std::string& file,
                             const char* key, bool required) {
   const cv::FileNode node = fs[key];
@@ -47,6 +66,7 @@ Result<cv::Mat> read_matrix(const cv::FileStorage& fs, const std::string& file,
     if (!required) return cv::Mat();
     return fail(fmt::format("{}: missing key '{}'", file, key));
   }
+  if (node.isMap() && node["dt"].empty()) return read_untagged_matrix(node, file, key);
   cv::Mat m;
   try {
     node >> m;
@@ -65,7 +85,25 @@ Result<int> read_positive_int(const cv::FileStorage& fs, const std::string& file
   if (!node.isInt()) return fail(fmt::format("{}: key '{}' is not an integer", file, key));
   const int v = static_cast<int>(node);
   if (v <= 0) return fail(fmt::format("{}: key '{}' must be positive, is {}", file, key, v));
+  // Views and renders allocate an image of this size: a damaged value must not ask for
+  // terabytes. 16384 px is twice an 8K sensor's width.
+  constexpr int kLargestSide_px = 16384;
+  if (v > kLargestSide_px)
+    return fail(fmt::format("{}: key '{}' is {} px, more than the {} px covtrack accepts", file, key, v, kLargestSide_px));
   return v;
+}
+
+// OpenCV's YAML reader wants its "%YAML:1.0" first line, which ROS's camera_info files
+// (camera_calibration_parsers) do not have: such a file is read with the line added.
+bool open_calibration(cv::FileStorage& fs, const std::filesystem::path& path) {
+  const auto ext = path.extension().string();
+  if (ext != ".yaml" && ext != ".yml") return fs.open(path.string(), cv::FileStorage::READ);
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  if (!yaml.starts_with("%YAML")) yaml = "%YAML:1.0\n---\n" + yaml;
+  return fs.open(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
 }
 
 }  // namespace
@@ -78,10 +116,17 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
   cv::FileStorage fs;
   try {
     // OpenCV throws on a malformed file; turn that into an error value.
-    if (!fs.open(file, cv::FileStorage::READ))
-      return fail(fmt::format("{}: cannot open as an OpenCV calibration file", file));
+    if (!open_calibration(fs, path))
+      return fail(fmt::format("{}: cannot open as an OpenCV or ROS camera_info calibration file", file));
   } catch (const cv::Exception& e) {
-    return fail(fmt::format("{}: not a readable OpenCV calibration file: {}", file, e.what()));
+    return fail(fmt::format("{}: not a readable OpenCV or ROS camera_info calibration file: {}", file, e.what()));
+  }
+  // ROS names its lens model; only the one covtrack computes (OpenCV's k1 k2 p1 p2 k3) is taken.
+  if (const cv::FileNode model = fs["distortion_model"]; !model.empty()) {
+    const std::string name = model.isString() ? static_cast<std::string>(model) : std::string("?");
+    if (name != "plumb_bob" && name != "rational_polynomial")
+      return fail(fmt::format("{}: distortion_model '{}' is not supported (plumb_bob or rational_polynomial with "
+                              "only k1 k2 p1 p2 k3 non-zero)", file, name));
   }
 
   Camera cam;
@@ -106,7 +151,7 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
   auto dist = read_matrix(fs, file, "distortion_coefficients", true);
   if (!dist) return std::unexpected(dist.error());
   const int n = static_cast<int>(dist->total());
-  if (n < 4)
+  if (n > 0 && n < 4)  // none (ROS writes an empty list for an undistorted camera), or k1 k2 p1 p2 [k3 ...]
     return fail(fmt::format("{}: key 'distortion_coefficients' needs 4 or 5 values, has {}",
                             file, n));
   for (int i = 0; i < n; ++i)
@@ -118,9 +163,9 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
           "{}: key 'distortion_coefficients': only k1 k2 p1 p2 k3 are supported, "
           "coefficient {} is non-zero",
           file, i));
-  cam.k1 = dist->at<double>(0), cam.k2 = dist->at<double>(1);
-  cam.p1 = dist->at<double>(2), cam.p2 = dist->at<double>(3);
-  cam.k3 = n > 4 ? dist->at<double>(4) : 0.0;
+  const auto coefficient = [&](int i) { return i < n ? dist->at<double>(i) : 0.0; };
+  cam.k1 = coefficient(0), cam.k2 = coefficient(1), cam.p1 = coefficient(2), cam.p2 = coefficient(3);
+  cam.k3 = coefficient(4);
 
   auto sig = read_matrix(fs, file, "intrinsics_std_deviations", false);
   if (!sig) return std::unexpected(sig.error());

@@ -361,9 +361,63 @@ TEST(CameraFile, MissingImageSizeAndUnsupportedDistortion) {
   EXPECT_NE(cam.error().message.find("distortion_coefficients"), std::string::npos);
 }
 
+TEST(CameraFile, AnImpossibleImageSizeIsAnErrorNotAnAllocation) {
+  const auto path = write_temp("covtrack_cam_huge.yml", std::string("%YAML:1.0\n---\nimage_width: 2000000000\n"
+                                                                    "image_height: 480\n") + kMatrix + kDist);
+  const auto cam = load_camera(path);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find("image_width"), std::string::npos) << cam.error().message;
+  EXPECT_NE(cam.error().message.find("2000000000"), std::string::npos) << cam.error().message;
+}
+
 TEST(CameraFile, GarbageIsAnErrorNotACrash) {
   const auto path = write_temp("covtrack_cam_garbage.yml", "%YAML:1.0\n---\n[[[ :: not yaml\n");
   const auto cam = load_camera(path);
   ASSERT_FALSE(cam);
   EXPECT_NE(cam.error().message.find(path.string()), std::string::npos);
+}
+
+// ROS's camera_info YAML (what `rosrun camera_calibration` saves): the same camera as
+// the shipped OpenCV file, and its other lens models refused by name.
+TEST(CameraFile, ReadsRosCameraInfoYaml) {
+  const auto ros = load_camera(COVTRACK_SOURCE_DIR "/tests/data/ros_camera_info_640x480.yaml");
+  ASSERT_TRUE(ros) << ros.error().message;
+  const auto cv = load_camera(COVTRACK_SOURCE_DIR "/config/cameras/example_640x480.yml");
+  ASSERT_TRUE(cv) << cv.error().message;
+  EXPECT_EQ(ros->width_px, 640);
+  EXPECT_EQ(ros->height_px, 480);
+  for (const auto& [a, b] : {std::pair{ros->fx, cv->fx}, {ros->fy, cv->fy}, {ros->cx, cv->cx}, {ros->cy, cv->cy},
+                             {ros->k1, cv->k1}, {ros->k2, cv->k2}, {ros->p1, cv->p1}, {ros->p2, cv->p2},
+                             {ros->k3, cv->k3}})
+    EXPECT_NEAR(a, b, 1e-9 * (1 + std::abs(b)));
+  const Vec3 p(0.2, -0.1, 1.0);
+  EXPECT_LT((ros->project(p) - cv->project(p)).norm(), 1e-9);
+}
+
+TEST(CameraFile, RosCameraInfoMistakesAreNamed) {
+  const std::string head = "image_width: 640\nimage_height: 480\n"
+                           "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n";
+  auto path = write_temp("covtrack_ros_fisheye.yaml", head + "distortion_model: equidistant\n"
+                                                             "distortion_coefficients:\n  rows: 1\n  cols: 4\n"
+                                                             "  data: [0.1, 0.01, 0, 0]\n");
+  auto cam = load_camera(path);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find("distortion_model 'equidistant'"), std::string::npos) << cam.error().message;
+  EXPECT_NE(cam.error().message.find(path.string()), std::string::npos) << cam.error().message;
+
+  path = write_temp("covtrack_ros_short.yaml", head + "distortion_model: plumb_bob\n"
+                                                      "distortion_coefficients:\n  rows: 1\n  cols: 5\n"
+                                                      "  data: [0.1, 0.01, 0]\n");
+  cam = load_camera(path);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find("1 x 5 matrix with 3 data entries"), std::string::npos) << cam.error().message;
+
+  // An undistorted camera: ROS writes an empty list.
+  path = write_temp("covtrack_ros_pinhole.yaml", head + "distortion_model: plumb_bob\n"
+                                                        "distortion_coefficients:\n  rows: 1\n  cols: 0\n"
+                                                        "  data: []\n");
+  cam = load_camera(path);
+  ASSERT_TRUE(cam) << cam.error().message;
+  EXPECT_EQ(cam->k1, 0);
+  EXPECT_DOUBLE_EQ(cam->fx, 500);
 }

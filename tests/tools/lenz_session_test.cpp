@@ -97,7 +97,7 @@ TEST(LenzSession, RawBytesReprocessedGiveTheRecordedPosesAndContainTheTruth) {
   ASSERT_GT(compared, 150);
   EXPECT_GE(double(agreeing) / compared, 0.95) << agreeing << " of " << compared;
   EXPECT_GT(first.decoder.counters().frames, 30u);
-  EXPECT_EQ(first.decoder.counters().bad_checksums, 0u);
+  EXPECT_EQ(first.decoder.counters().bad_frames, 0u);
 
   // Re-estimate at every recorded truth time: the truth inside the 99% interval.
   log->rewind();

@@ -233,7 +233,7 @@ void add_render_tags_command(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render-tags", "render AprilTags at known poses (images or "
                                                     "video + truth.csv): the fiducial emulator");
-  cmd->add_option("--camera", args->camera, "OpenCV calibration file")->required();
+  cmd->add_option("--camera", args->camera, "camera calibration: OpenCV (YAML/XML) or ROS camera_info YAML")->required();
   cmd->add_option("--out", args->out, "output folder (frames and truth.csv)")->required();
   cmd->add_option("--tag", args->tags, "id,size_m,x,y,z,roll_deg,pitch_deg,yaw_deg (T_camera_tag; "
                                        "repeat for more tags)");

@@ -124,7 +124,7 @@ void bind_scene(py::module_& m) {
 
   py::class_<client::Camera>(m, "Camera", "A pinhole camera with OpenCV's k1 k2 p1 p2 k3 distortion")
       .def_static("load", [](const std::string& path) { return value_or_raise(client::load_camera(path)); },
-                  py::arg("path"), "Reads an OpenCV calibration file (camera_matrix, distortion_coefficients, ...)")
+                  py::arg("path"), "Reads a camera calibration: OpenCV (camera_matrix, distortion_coefficients, ...) or ROS camera_info YAML")
       .def_readonly("fx", &client::Camera::fx)
       .def_readonly("fy", &client::Camera::fy)
       .def_readonly("cx", &client::Camera::cx)

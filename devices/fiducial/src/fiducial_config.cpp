@@ -20,8 +20,8 @@ const TableSpec& fiducial_device_spec() {
         {"source", ValueType::String, "", "", "camera: V4L2 index (\"0\"); or image files: a "
          "pattern (\"frames/frame_%04d.png\", numbered from 0 or 1) or one image; or a video file; "
          "relative to this file; `covtrackd --check` opens it"},
-        {"calibration", ValueType::String, "", "", "OpenCV calibration file (camera_matrix, "
-         "distortion_coefficients, image_width, image_height); relative to this file"},
+        {"calibration", ValueType::String, "", "", "camera calibration: OpenCV's file (camera_matrix, "
+         "distortion_coefficients, image_width, image_height) or ROS's camera_info YAML; relative to this file"},
         {"family", ValueType::String, "", "\"tag36h11\"", "AprilTag family"},
         {"decimate", ValueType::Float, "", "2", "quad search on an image this much smaller", 1, 8},
         {"quad_sigma", ValueType::Float, "px", "0", "blur before the quad search (0.8 speeds up "

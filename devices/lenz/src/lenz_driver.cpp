@@ -86,7 +86,7 @@ class LenzDriver final : public Driver {
     // million bytes, where a frame with a valid XOR byte turns up once in 256.
     ValidFrameWatchdog watchdog(config_.no_valid_frames_s, Clock::now());
     std::uint64_t bytes_since_reply = 0;
-    const std::uint64_t bad_frames_at_start = decoder_.counters().bad_checksums;
+    const std::uint64_t bad_frames_at_start = decoder_.counters().bad_frames;
     std::uint8_t buffer[256];
     while (!stop.stop_requested()) {
       const auto wait = std::clamp(duration_cast<milliseconds>(next_sample_ - Clock::now()), milliseconds(0),
@@ -112,7 +112,7 @@ class LenzDriver final : public Driver {
         device_failed_ = Error{fmt::format(
             "serial port {}: {} (no answer to the status request in {} bytes; {} bad frames this "
             "connection); the interface will be reset",
-            config_.port, *expired, bytes_since_reply, decoder_.counters().bad_checksums - bad_frames_at_start)};
+            config_.port, *expired, bytes_since_reply, decoder_.counters().bad_frames - bad_frames_at_start)};
         return std::unexpected(*device_failed_);
       }
       if (now >= next_keepalive) {
@@ -167,8 +167,8 @@ class LenzDriver final : public Driver {
     const FramingCounters before = decoder_.counters();
     const auto frames = decoder_.push(bytes);
     const FramingCounters& after = decoder_.counters();
-    for (auto i = before.bad_checksums; i < after.bad_checksums; ++i) {
-      sink.count_error(fmt::format("{}: frame with a bad XOR byte skipped", config_.port));
+    for (auto i = before.bad_frames; i < after.bad_frames; ++i) {
+      sink.count_error(fmt::format("{}: bytes that are not a frame skipped (bad XOR byte or stray header)", config_.port));
       sink.count_resync();
     }
     for (const auto& frame : frames) {

@@ -1,5 +1,6 @@
 #include "covtrack/lcmlog/replayer.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -43,8 +44,13 @@ Result<ReplaySummary> replay(LogReader& reader, lcm::LCM& lcm, const ReplayOptio
     while (auto event = reader.next()) {
       if ((stopped_in_pass = stop.load(std::memory_order_relaxed))) break;
       if (!log_start_us) log_start_us = event->timestamp_us;
-      const std::int64_t since_start_us = event->timestamp_us - *log_start_us;
-      if (since_start_us < static_cast<std::int64_t>(options.start_s * 1e6)) continue;
+      // Times relative to the first event, in double: a damaged log's timestamps can be
+      // anything, and int64 differences of such overflow. An event timed before the first
+      // (recorders stamp in the order they receive, which is not always time order) is
+      // published like the others, at once, as lcm-logplayer does; --start skips only
+      // events timed within its first seconds.
+      const double since_start_s = 1e-6 * (static_cast<double>(event->timestamp_us) - static_cast<double>(*log_start_us));
+      if (options.start_s > 0 && since_start_s < options.start_s) continue;
       if (!filter->matches(event->channel)) continue;
 
       if (options.speed > 0) {
@@ -52,10 +58,11 @@ Result<ReplaySummary> replay(LogReader& reader, lcm::LCM& lcm, const ReplayOptio
           pace_base_us = event->timestamp_us;
           pass_started = Clock::now();
         }
-        const auto due = pass_started + std::chrono::duration_cast<Clock::duration>(
-                                            std::chrono::duration<double, std::micro>(
-                                                (event->timestamp_us - *pace_base_us) /
-                                                options.speed));
+        // Clamped to a day ahead: a damaged timestamp must not overflow the clock's type.
+        const double wait_s = std::clamp(
+            1e-6 * (static_cast<double>(event->timestamp_us) - static_cast<double>(*pace_base_us)) / options.speed,
+            0.0, 86400.0);
+        const auto due = pass_started + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wait_s));
         for (auto now = Clock::now(); now < due && !stop.load(); now = Clock::now()) {
           report();
           std::this_thread::sleep_until(std::min(due, now + kMaxWaitSlice));
@@ -74,7 +81,7 @@ Result<ReplaySummary> replay(LogReader& reader, lcm::LCM& lcm, const ReplayOptio
       ++summary.events_published;
       ++published_this_pass;
       summary.payload_bytes += event->payload.size();
-      log_time_s = static_cast<double>(since_start_us) * 1e-6;
+      log_time_s = std::max(log_time_s, since_start_s);
       if (summary.events_published % kProgressEveryEvents == 0) report();
     }
     report();

@@ -28,7 +28,7 @@ const TableSpec& camera_spec() {
   static const TableSpec s{"camera", "covtrack regions",
                            {{"frame", ValueType::String, "", "", "the camera's frame in the tree"},
                             {"calibration", ValueType::String, "", "",
-                             "OpenCV calibration file (YAML/XML), relative to the scene file"},
+                             "camera calibration: OpenCV (YAML/XML) or ROS camera_info YAML, relative to the scene file"},
                             {"confidence", ValueType::Float, "", "0.95",
                              "probability inside each error ellipse", 0.5, 0.9999}}};
   return s;

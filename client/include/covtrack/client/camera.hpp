@@ -53,10 +53,13 @@ struct Camera {
   Mat2 intrinsic_covariance_at(const Vec2& pixel) const;
 };
 
-// Reads `camera_matrix`, `distortion_coefficients` (4 or 5 values; longer vectors only if
-// the extra terms are zero), `image_width`, `image_height`, and the optional
-// `intrinsics_std_deviations` (fx fy cx cy first, as cv::calibrateCamera orders them).
-// Errors name the file and the key.
+// Reads `camera_matrix`, `distortion_coefficients` (4 or 5 values, or none; longer
+// vectors only if the extra terms are zero), `image_width`, `image_height`, and the
+// optional `intrinsics_std_deviations` (fx fy cx cy first, as cv::calibrateCamera orders
+// them). Two layouts: OpenCV's (cv::FileStorage YAML or XML, as its calibration sample
+// writes) and ROS's camera_info YAML (camera_calibration_parsers: untagged {rows, cols,
+// data} matrices, `distortion_model` plumb_bob or rational_polynomial; the rectification
+// and projection matrices, for stereo, are not used). Errors name the file and the key.
 Result<Camera> load_camera(const std::filesystem::path& file);
 
 }  // namespace covtrack::client
