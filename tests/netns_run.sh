@@ -8,5 +8,5 @@ if [ "$COVTRACK_IN_NETNS" != 1 ]; then
 fi
 ip link set lo up
 ip link set lo multicast on
-ip route add 224.0.0.0/4 dev lo
+ip route replace 224.0.0.0/4 dev lo  # replace: run again inside its own namespace, it is there already
 exec "$@"

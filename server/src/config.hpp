@@ -1,10 +1,12 @@
 #pragma once
 // The daemon's TOML config, validated completely before anything starts.
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "covtrack/protocol/result.hpp"
 #include "driver_table.hpp"
+#include "vrpn_server_config.hpp"
 
 namespace covtrack::server {
 
@@ -20,11 +22,13 @@ struct DeviceConfig {
   std::string name;
   std::string type;
   DriverFactory make;
+  std::string parent_frame = "world";  // the device's parent_frame key
 };
 
 struct DaemonConfig {
   DaemonSettings daemon;
   std::vector<DeviceConfig> devices;  // enabled devices only
+  std::optional<VrpnServerConfig> vrpn_server;
 };
 
 // What a config load checks beyond the config itself.

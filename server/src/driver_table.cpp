@@ -6,6 +6,7 @@
 #include "covtrack/devices/lenz/lenz_driver.hpp"
 #include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 #include "covtrack/devices/sim/sim_driver.hpp"
+#include "covtrack/devices/vrpn/vrpn_driver.hpp"
 
 namespace covtrack::server {
 namespace {
@@ -54,6 +55,13 @@ const std::vector<DriverType>& driver_types() {
        [](TableReader& device, const std::string& name) -> DriverFactory {
          fiducial::FiducialConfig config = fiducial::read_fiducial_config(device, name);
          return [config](std::uint64_t run) { return fiducial::make_fiducial_driver(config, run); };
+       }},
+      {"vrpn", "a tracker served by a vrpn_server (\"Tracker0@host\"), read over TCP, republished with a "
+       "covariance from config",
+       {&vrpn::vrpn_device_spec(), &vrpn::vrpn_sensor_spec()},
+       [](TableReader& device, const std::string& name) -> DriverFactory {
+         vrpn::VrpnConfig config = vrpn::read_vrpn_config(device, name);
+         return [config](std::uint64_t) { return vrpn::make_vrpn_driver(config); };
        }},
   };
   return table;

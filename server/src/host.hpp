@@ -19,6 +19,8 @@ class Host {
   Host(const DaemonConfig& config, lcm::LCM& lcm);
   ~Host();
 
+  // Before start(): every published pose also goes to `tap` (see Publisher::tap_poses).
+  void tap_poses(Publisher::PoseTap tap) { publisher_.tap_poses(std::move(tap)); }
   void start();
   // Asks every device and the heartbeat to stop, and waits for each device's thread up
   // to daemon.stop_timeout_s in all. Returns a line per device whose thread is still

@@ -8,20 +8,17 @@
 #include <spdlog/spdlog.h>
 
 #include "config.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 #include "host.hpp"
 #include "stop_signals.hpp"
+#include "vrpn_server.hpp"
 
 namespace {
-// Exit codes (also in --help and README.md).
-constexpr int kExitCannotStart = 1;
-constexpr int kExitBadConfig = 2;
-constexpr int kExitDeviceDidNotStop = 3;
-constexpr const char* kExitCodes =
-    "Exit codes: 0 stopped by SIGINT/SIGTERM; 1 could not start (LCM); 2 bad config or usage; "
-    "3 stopped, but a device's thread did not end within daemon.stop_timeout_s (named on the log; "
-    "the daemon exits anyway). A stop signal before the devices start ends covtrackd at once, "
-    "by that signal (status 130 or 143 in a shell).";
+using namespace covtrack::program;
+constexpr const char* kSignalNote =
+    "A stop signal before the devices start ends covtrackd at once, by that signal (status 130 or 143 in a "
+    "shell). Exit code 4 names the stuck device on the log; the daemon exits anyway.";
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -30,20 +27,16 @@ int main(int argc, char** argv) {
   covtrack::server::end_at_once_on_stop_signal();
 
   CLI::App app{"covtrackd: tracker daemon publishing pose + covariance over LCM", "covtrackd"};
-  app.footer(kExitCodes);
   std::string config_path, lcm_url, log_level = "info";
   bool check_only = false, print_schema = false;
   app.add_option("--config,-c", config_path, "daemon config (TOML; a file or a pipe), e.g. config/sim.toml");
-  app.add_option("--lcm-url", lcm_url, "LCM URL (overrides the config's daemon.lcm_url)");
+  app.add_option("--lcm-url,-u", lcm_url, "LCM URL (overrides the config's daemon.lcm_url)");
   app.add_flag("--check", check_only, "validate the config, open every file and device it names, and exit");
   app.add_flag("--print-schema", print_schema, "print the config schema (Markdown) and exit");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : kExitBadConfig;
-  }
+  add_conventions(app, kSignalNote);
+  if (const auto code = parse_command_line(app, argc, argv)) return *code;
   spdlog::set_level(spdlog::level::from_str(log_level));
 
   if (print_schema) {
@@ -52,7 +45,7 @@ int main(int argc, char** argv) {
   }
   if (config_path.empty()) {
     std::cerr << "covtrackd: --config FILE is required (try config/sim.toml)\n";
-    return kExitBadConfig;
+    return kExitUsageError;
   }
   // --check also opens what the devices name (files, folders, device nodes); a start
   // does not, as a device missing now may appear later and its driver retries it.
@@ -61,7 +54,7 @@ int main(int argc, char** argv) {
   if (!config) {
     std::cerr << "covtrackd: the config has errors; nothing was started:\n"
               << config.error().message;
-    return kExitBadConfig;
+    return kExitUsageError;
   }
   if (check_only) {
     std::cout << config_path << ": OK, " << config->devices.size() << " device(s)\n";
@@ -69,7 +62,7 @@ int main(int argc, char** argv) {
   }
   if (config->devices.empty()) {
     std::cerr << "covtrackd: " << config_path << ": every device is disabled; nothing to run\n";
-    return kExitBadConfig;
+    return kExitUsageError;
   }
 
   // Before LCM or the host start a thread: from here on every thread inherits the mask.
@@ -78,10 +71,25 @@ int main(int argc, char** argv) {
   auto lcm = covtrack::open_lcm(url);
   if (!lcm) {
     std::cerr << "covtrackd: " << lcm.error().message << "\n";
-    return kExitCannotStart;
+    return kExitRuntimeError;
   }
 
+  // Declared before the host: destroyed after the device threads that feed it.
+  std::unique_ptr<covtrack::server::VrpnServer> vrpn_server;
+  if (config->vrpn_server) {
+    auto opened = covtrack::server::VrpnServer::open(*config->vrpn_server);
+    if (!opened) {
+      std::cerr << "covtrackd: " << opened.error().message << "\n";
+      return kExitRuntimeError;
+    }
+    vrpn_server = std::move(*opened);
+    vrpn_server->start();
+  }
   covtrack::server::Host host(*config, **lcm);
+  if (vrpn_server)
+    host.tap_poses([server = vrpn_server.get()](const std::string& device, const covtrack::PoseSample& s) {
+      server->offer(device, s);
+    });
   host.start();
   spdlog::info("covtrackd: {} device(s) publishing on {}", config->devices.size(), url);
 

@@ -32,10 +32,15 @@ bool Publisher::pose(const std::string& device, const PoseSample& s) {
   set_pose(msg, s.T_parent_child, s.covariance);
   msg.status = static_cast<std::int8_t>(s.status);
   const std::string channel = pose_channel(device, s.sensor);
-  std::lock_guard lock(mutex_);
-  msg.sequence = next_sequence(channel);
-  msg.publish_time_us = now_us();
-  return send(channel, msg);
+  bool sent = false;
+  {
+    std::lock_guard lock(mutex_);
+    msg.sequence = next_sequence(channel);
+    msg.publish_time_us = now_us();
+    sent = send(channel, msg);
+  }
+  if (tap_) tap_(device, s);
+  return sent;
 }
 
 bool Publisher::truth(const std::string& device, const TruthSample& s) {

@@ -3,6 +3,7 @@
 // stamps publish time and the per-stream sequence numbers, which survive driver restarts
 // so that a client sees a gap only when a message was really lost.
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <unordered_map>
@@ -19,6 +20,11 @@ class Publisher {
  public:
   explicit Publisher(lcm::LCM& lcm) : lcm_(lcm) {}
 
+  // Sees every pose after it is published (the VRPN server). Set before the devices
+  // start; it runs on the device's thread, so it must not block.
+  using PoseTap = std::function<void(const std::string& device, const PoseSample& sample)>;
+  void tap_poses(PoseTap tap) { tap_ = std::move(tap); }
+
   // Each returns false if LCM failed to send (the caller counts it as a drop).
   bool pose(const std::string& device, const PoseSample& sample);
   bool truth(const std::string& device, const TruthSample& sample);
@@ -33,6 +39,7 @@ class Publisher {
   bool send(const std::string& channel, const Msg& msg);
 
   lcm::LCM& lcm_;
+  PoseTap tap_;
   std::mutex mutex_;  // LCM's publish is thread-safe; this guards the counters and buffer
   std::unordered_map<std::string, std::int64_t> sequences_;
   std::vector<std::uint8_t> buffer_;

@@ -324,3 +324,18 @@ TEST(VrpnTrackerAddress, ParsesVrpnNames) {
     EXPECT_NE(r.error().message.find(bad), std::string::npos) << r.error().message;
   }
 }
+
+// Fact (finish_new_connection_setup, pack_udp_description): a client not connected over
+// TCP only tells the server its UDP port in the sender field of a type -3 message whose
+// payload is its address and a NUL; like any message, not before the handshake.
+TEST(VrpnSession, UdpDescriptionAfterTheHandshakeByteForByte) {
+  Session s({"Tracker0"}, {std::string(kTrackerPosQuat)});
+  s.take_output();
+  EXPECT_FALSE(s.describe_udp("127.0.0.1", 40000, 0)) << "nothing but the cookie before the peer's cookie";
+  const Cookie c = make_cookie();
+  ASSERT_TRUE(s.receive(Bytes(c.begin(), c.end()), 0));
+  s.take_output();  // our descriptions
+  ASSERT_TRUE(s.describe_udp("127.0.0.1", 40000, 2'000'003));
+  EXPECT_EQ(s.take_output(), hex("00 00 00 22  00 00 00 02  00 00 00 03  00 00 9c 40  ff ff ff fd  00 00 00 02"
+                                 "31 32 37 2e 30 2e 30 2e 31 00  00 00 00 00 00 00"));
+}

@@ -6,7 +6,7 @@
 // - a --config that is a FIFO nobody writes to: SIGTERM ends the daemon while it waits
 //   (the signals are handled before the config is read), saying so;
 // - a config that comes through a pipe is read, so `--config <(make-config)` works.
-// The daemon's limit on a driver that never returns (exit code 3) is host_stop_test's.
+// The daemon's limit on a driver that never returns (exit code 4) is host_stop_test's.
 #include <gtest/gtest.h>
 
 #include <fcntl.h>

@@ -17,9 +17,9 @@ struct CliRun {
   std::string out;  // stdout and stderr together
 };
 
-// `covtrack ARGS`, with `env_prefix` (e.g. "env -u DISPLAY") before it.
-inline CliRun run_covtrack(const std::string& args, const std::string& env_prefix = "") {
-  const std::string cmd = env_prefix + " " + std::string(COVTRACK_CLI) + " " + args + " 2>&1";
+// A shell command line, stderr with stdout.
+inline CliRun run_command(const std::string& command) {
+  const std::string cmd = command + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");
   if (!pipe) return {-1, "popen failed"};
   std::string out;
@@ -27,6 +27,11 @@ inline CliRun run_covtrack(const std::string& args, const std::string& env_prefi
   while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
   const int status = ::pclose(pipe);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+// `covtrack ARGS`, with `env_prefix` (e.g. "env -u DISPLAY") before it.
+inline CliRun run_covtrack(const std::string& args, const std::string& env_prefix = "") {
+  return run_command(env_prefix + " " + std::string(COVTRACK_CLI) + " " + args);
 }
 
 // Inside a counter-clockwise convex polygon [[u, v], ...] (in u, v arithmetic), or within

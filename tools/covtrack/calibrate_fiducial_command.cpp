@@ -14,6 +14,7 @@
 #include <fmt/ranges.h>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/devices/fiducial/board_calibration.hpp"
 #include "covtrack/devices/fiducial/fiducial_config.hpp"
 #include "covtrack/devices/fiducial/frame_source.hpp"
@@ -139,9 +140,9 @@ void add_calibrate_fiducial_command(CLI::App& app) {
   cmd->add_option("--board", args->board, "the bundle to use as the board (its [[bundles]] name)")->required();
   cmd->add_option("--source", args->source, "frames to read instead of the device's source (images: a "
                                             "pattern such as frames/frame_%04d.png; or a video file)");
-  cmd->add_option("--out", args->out, "the corner model file to write")->required();
-  cmd->add_option("--max-frames", args->max_frames, "read at most this many frames")
-      ->capture_default_str()->check(CLI::Range(1, 1000000));
+  cmd->add_option("--out,-o", args->out, "the corner model file to write")->required();
+  cmd->add_option("--max-frames,-n", args->max_frames, "read at most this many frames")
+      ->capture_default_str()->check(program::in_range(1, 1000000));
   cmd->callback([args] {
     const int rc = run_calibrate(*args);
     if (rc != 0) throw CLI::RuntimeError(rc);

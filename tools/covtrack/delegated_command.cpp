@@ -8,6 +8,8 @@
 #include <iostream>
 #include <vector>
 
+#include "covtrack/program/exit_codes.hpp"
+
 namespace covtrack::cli {
 
 void add_delegated_command(CLI::App& app, const std::string& name, const std::string& description,
@@ -27,7 +29,7 @@ void add_delegated_command(CLI::App& app, const std::string& name, const std::st
     ::execv(path.c_str(), argv.data());
     std::cerr << "covtrack " << name << ": cannot run " << path << ": " << std::strerror(errno)
               << " (it is built and installed next to covtrack)\n";
-    throw CLI::RuntimeError(2);
+    throw CLI::RuntimeError(program::kExitRuntimeError);
   });
 }
 

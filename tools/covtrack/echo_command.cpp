@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
@@ -180,7 +181,7 @@ int run_echo(const EchoOptions& o) {
       hinted = true;
       if ((*sub)->streams().empty() && (*sub)->devices().empty())
         std::cerr << fmt::format("covtrack echo: nothing received for {} s on {} (streams '{}'): is covtrackd "
-                                 "running and publishing there? (covtrackd --config config/sim.toml)\n",
+                                 "running and publishing there? (covtrackd --config config/sim.toml); still waiting, Ctrl-C ends\n",
                                  kSilenceHint.count(), effective_lcm_url(o.subscriber.lcm_url),
                                  o.subscriber.pattern);
     }
@@ -201,12 +202,12 @@ void add_echo_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("echo", "show pose streams live (table, or JSON per message)");
   cmd->add_option("pattern", o->subscriber.pattern,
                   "regular expression over device/sensor, whole match (default: all)");
-  cmd->add_flag("--json", o->json, "one JSON object per message, one per line");
-  cmd->add_option("--lcm-url", o->subscriber.lcm_url, "LCM URL");
+  cmd->add_flag("--json,-j", o->json, "one JSON object per message, one per line");
+  cmd->add_option("--lcm-url,-u", o->subscriber.lcm_url, "LCM URL");
   cmd->add_option("--stale", o->subscriber.stale_after_s, "seconds without a message before a stream is stale")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--count", o->count, "exit after this many accepted messages")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--duration", o->duration_s, "exit after this many seconds")->check(CLI::NonNegativeNumber);
+      ->check(program::positive());
+  cmd->add_option("--count,-n", o->count, "exit after this many accepted messages")->check(program::non_negative());
+  cmd->add_option("--duration,-d", o->duration_s, "exit after this many seconds")->check(program::non_negative());
   cmd->callback([o] {
     if (const int rc = run_echo(*o); rc != 0) throw CLI::RuntimeError(rc);
   });

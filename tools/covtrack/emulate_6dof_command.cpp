@@ -14,6 +14,7 @@
 #include <covtrack/truth_pose_t.hpp>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/emulate6dof/emulator.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
@@ -130,16 +131,16 @@ void add_emulate_6dof_command(CLI::App& app) {
   cmd->add_option("--stations", args->stations, "station numbers (Flock: bird addresses)")
       ->delimiter(',');
   cmd->add_option("--rate-hz", args->rate_hz, "records per second per station (default: the model's)")
-      ->check(CLI::Range(0.1, 10000.0));
+      ->check(program::in_range(0.1, 10000.0));
   cmd->add_option("--reset-time-s", args->reset_time_s, "how long a reset takes (default: the model's)")
-      ->check(CLI::Range(0.0, 120.0));
+      ->check(program::in_range(0.0, 120.0));
   cmd->add_option("--seed", args->seed, "noise seed");
   cmd->add_option("--trouble-every-s", args->trouble_every_s,
                   "flag one record set this often (status letter / error code), with inflated noise")
-      ->check(CLI::Range(0.0, 1e6));
-  cmd->add_option("--duration", args->duration_s, "stop after S seconds (default: until Ctrl-C)");
+      ->check(program::in_range(0.0, 1e6));
+  cmd->add_option("--duration,-d", args->duration_s, "stop after S seconds (default: until Ctrl-C)");
   cmd->add_option("--device", args->device, "device name for the truth channels (default: the protocol)");
-  cmd->add_option("--lcm-url", args->lcm_url, "LCM URL for the truth (default: $LCM_DEFAULT_URL or LCM's)");
+  cmd->add_option("--lcm-url,-u", args->lcm_url, "LCM URL for the truth (default: $LCM_DEFAULT_URL or LCM's)");
   cmd->add_flag("--no-truth", args->no_truth, "do not publish the truth (no LCM at all)");
   cmd->callback([args] {
     if (const int rc = run_emulate(*args); rc != 0) throw CLI::RuntimeError(rc);

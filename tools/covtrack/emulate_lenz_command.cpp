@@ -14,6 +14,7 @@
 #include <covtrack/truth_pose_t.hpp>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/devices/lenz/layout_config.hpp"
 #include "covtrack/emulators/lenz/lenz_emulator.hpp"
 #include "covtrack/protocol/channels.hpp"
@@ -125,16 +126,16 @@ void add_emulate_lenz_command(CLI::App& app) {
   cmd->add_option("--profile", args->profile, "Speed profile speed_mps:hold_s,... (repeats; ends with a stop)")
       ->capture_default_str();
   cmd->add_option("--accel", args->accel_mps2, "Acceleration, m/s^2 (default: 80% of the layout's max_accel_mps2)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(program::non_negative());
   cmd->add_option("--device", args->device, "Device name of the daemon's lenz driver (truth channel names)")
       ->capture_default_str();
   cmd->add_option("--parent-frame", args->parent_frame, "Frame of the truth poses")->capture_default_str();
   cmd->add_option("--truth-hz", args->truth_hz, "Truth poses per second per vehicle")
-      ->check(CLI::Range(0.1, 1000.0))
+      ->check(program::in_range(0.1, 1000.0))
       ->capture_default_str();
   cmd->add_flag("--no-truth", args->no_truth, "Publish nothing on LCM");
-  cmd->add_option("--duration", args->duration_s, "Stop after S seconds")->check(CLI::PositiveNumber);
-  cmd->add_option("--lcm-url", args->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or LCM's)");
+  cmd->add_option("--duration,-d", args->duration_s, "Stop after S seconds")->check(program::positive());
+  cmd->add_option("--lcm-url,-u", args->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or LCM's)");
   cmd->callback([args] {
     if (const int code = run_emulate_lenz(*args); code != 0) throw CLI::RuntimeError(code);
   });

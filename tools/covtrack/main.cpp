@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "delegated_command.hpp"
 
 int main(int argc, char** argv) {
@@ -22,6 +23,6 @@ int main(int argc, char** argv) {
   covtrack::cli::add_emulate_lenz_command(app);
   covtrack::cli::add_emulate_6dof_command(app);
   covtrack::cli::add_devices_command(app);
-  CLI11_PARSE(app, argc, argv);
-  return 0;
+  covtrack::program::add_conventions(app);
+  return covtrack::program::parse_command_line(app, argc, argv).value_or(covtrack::program::kExitOk);
 }

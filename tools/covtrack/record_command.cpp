@@ -10,6 +10,7 @@
 #include <fmt/core.h>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/lcmlog/log_writer.hpp"
 #include "covtrack/lcmlog/recorder.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
@@ -94,10 +95,10 @@ void add_record_command(CLI::App& app) {
   cmd->add_option("--channels", args->channels,
                   "Regular expression matching whole channel names")
       ->capture_default_str();
-  cmd->add_option("--duration", args->duration_s, "Stop after S seconds")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--lcm-url", args->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or LCM's)");
-  cmd->add_flag("--force", args->force, "Overwrite FILE if it exists");
+  cmd->add_option("--duration,-d", args->duration_s, "Stop after S seconds")
+      ->check(program::positive());
+  cmd->add_option("--lcm-url,-u", args->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or LCM's)");
+  cmd->add_flag("--force,-f", args->force, "Overwrite FILE if it exists");
   cmd->callback([args] {
     if (const int code = run_record(*args); code != 0) throw CLI::RuntimeError(code);
   });

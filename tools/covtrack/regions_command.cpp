@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/scene/scene.hpp"
 #include "region_drawing.hpp"
@@ -154,22 +155,22 @@ void add_regions_command(CLI::App& app) {
   auto args = std::make_shared<RegionsArgs>();
   auto* cmd = app.add_subcommand("regions", "Screen error regions of a scene's objects (offline)");
   cmd->add_option("SCENE", args->scene_path, "Scene file (config/scene_schema.md)");
-  cmd->add_flag("--json", args->json, "One JSON document instead of text");
+  cmd->add_flag("--json,-j", args->json, "One JSON document instead of text");
   cmd->add_option("--png", args->png_path, "Also draw the regions into this PNG file");
   cmd->add_flag("--print-schema", args->print_schema, "Print the scene file reference (Markdown)");
   const std::map<std::string, client::ProjectionMethod> methods = {
       {"unscented", client::ProjectionMethod::unscented}, {"linear", client::ProjectionMethod::linear}};
   cmd->add_option("--method", args->method, "Vertex projection: unscented or linear")
-      ->transform(CLI::CheckedTransformer(methods));
+      ->transform(program::one_of(methods));
   const std::map<std::string, client::Propagation> propagations = {
       {"lca", client::Propagation::LowestCommonAncestor},
       {"seed-root", client::Propagation::SeedRoot},
       {"seed-matrix16", client::Propagation::SeedMatrix16}};
   cmd->add_option("--propagation", args->propagation,
                   "lca (exact, default), or the seed's seed-root / seed-matrix16 for comparison")
-      ->transform(CLI::CheckedTransformer(propagations));
+      ->transform(program::one_of(propagations));
   cmd->add_option("--confidence", args->confidence, "Confidence of the regions (default: the scene's)")
-      ->check(CLI::Range(0.5, 0.9999));
+      ->check(program::in_range(0.5, 0.9999));
   cmd->callback([args] {
     if (const int code = run_regions(*args); code != 0) throw CLI::RuntimeError(code);
   });

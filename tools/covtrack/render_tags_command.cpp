@@ -20,6 +20,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/devices/fiducial/fiducial_config.hpp"
 #include "covtrack/devices/fiducial/tag_image_formation.hpp"
 
@@ -177,7 +178,7 @@ int run_render(const RenderArgs& a) {
     video.open(a.video, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30,
                {camera->width_px, camera->height_px}, false);
     if (!video.isOpened())
-      return fmt::print(stderr, "covtrack render-tags: cannot write video '{}'\n", a.video), 2;
+      return fmt::print(stderr, "covtrack render-tags: cannot write video '{}'\n", a.video), 1;
   }
   std::ofstream truth(std::filesystem::path(a.out) / "truth.csv");
   truth << "# frame,id,size_m,x_m,y_m,z_m,qw,qx,qy,qz  (T_camera_tag; camera: OpenCV frame)\n";
@@ -234,7 +235,7 @@ void add_render_tags_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("render-tags", "render AprilTags at known poses (images or "
                                                     "video + truth.csv): the fiducial emulator");
   cmd->add_option("--camera", args->camera, "camera calibration: OpenCV (YAML/XML) or ROS camera_info YAML")->required();
-  cmd->add_option("--out", args->out, "output folder (frames and truth.csv)")->required();
+  cmd->add_option("--out,-o", args->out, "output folder (frames and truth.csv)")->required();
   cmd->add_option("--tag", args->tags, "id,size_m,x,y,z,roll_deg,pitch_deg,yaw_deg (T_camera_tag; "
                                        "repeat for more tags)");
   cmd->add_option("--bundle", args->bundles, "NAME,x,y,z,roll_deg,pitch_deg,yaw_deg: every tag of the "
@@ -244,33 +245,33 @@ void add_render_tags_command(CLI::App& app) {
                                                         "the bundles (their [[bundles]])");
   cmd->add_option("--family", args->family, "AprilTag family")->capture_default_str();
   cmd->add_option("--video", args->video, "write this video file (FFV1) instead of PNG frames");
-  cmd->add_option("--frames", args->frames, "frame count")->capture_default_str()->check(CLI::Range(1, 1000000));
+  cmd->add_option("--frames,-n", args->frames, "frame count")->capture_default_str()->check(program::in_range(1, 1000000));
   cmd->add_option("--swing-deg", args->swing_deg, "yaw swing amplitude")->capture_default_str();
-  cmd->add_option("--period-frames", args->period_frames, "frames per swing")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--period-frames", args->period_frames, "frames per swing")->capture_default_str()->check(program::positive());
   cmd->add_option("--wander-deg", args->wander_deg, "each frame, turn every tag and bundle about its centre by "
                                                    "a random angle up to this about each axis (a board waved in "
                                                    "front of the camera)")
-      ->capture_default_str()->check(CLI::Range(0.0, 90.0));
+      ->capture_default_str()->check(program::in_range(0.0, 90.0));
   cmd->add_option("--wander-m", args->wander_m, "each frame, move every tag and bundle by up to this along "
                                                "each camera axis")
-      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
-  cmd->add_option("--noise", args->noise, "sensor noise sigma (grey levels)")->capture_default_str()->check(CLI::Range(0.0, 100.0));
-  cmd->add_option("--blur", args->blur, "optical blur sigma (px)")->capture_default_str()->check(CLI::Range(0.0, 20.0));
+      ->capture_default_str()->check(program::in_range(0.0, 10.0));
+  cmd->add_option("--noise", args->noise, "sensor noise sigma (grey levels)")->capture_default_str()->check(program::in_range(0.0, 100.0));
+  cmd->add_option("--blur", args->blur, "optical blur sigma (px)")->capture_default_str()->check(program::in_range(0.0, 20.0));
   cmd->add_option("--black", args->black, "tag black level")->capture_default_str();
   cmd->add_option("--white", args->white, "tag white level")->capture_default_str();
   cmd->add_option("--background", args->background, "background level")->capture_default_str();
   cmd->add_option("--seed", args->seed, "noise seed")->capture_default_str();
   cmd->add_option("--gamma", args->gamma, "the camera's tone curve: grey = 255 (linear)^(1/gamma); "
                                           "sRGB-like cameras are near 2.2")
-      ->capture_default_str()->check(CLI::Range(0.2, 5.0));
+      ->capture_default_str()->check(program::in_range(0.2, 5.0));
   cmd->add_option("--defocus", args->defocus, "defocus disk radius (px), on top of --blur")
-      ->capture_default_str()->check(CLI::Range(0.0, 20.0));
+      ->capture_default_str()->check(program::in_range(0.0, 20.0));
   cmd->add_option("--vignetting", args->vignetting, "light lost at the frame's corners (0-0.9)")
-      ->capture_default_str()->check(CLI::Range(0.0, 0.9));
+      ->capture_default_str()->check(program::in_range(0.0, 0.9));
   cmd->add_option("--full-well", args->full_well, "electrons at full scale, for shot noise (0: none)")
-      ->capture_default_str()->check(CLI::Range(0.0, 1e7));
+      ->capture_default_str()->check(program::in_range(0.0, 1e7));
   cmd->add_option("--jpeg", args->jpeg, "JPEG quality the camera compresses with (0: none)")
-      ->capture_default_str()->check(CLI::Range(0, 100));
+      ->capture_default_str()->check(program::in_range(0, 100));
   cmd->add_option("--rasteriser", args->rasteriser, "how tags are drawn: supersampled (texture "
                                                     "warped 4x finer, area-averaged) or analytic "
                                                     "(exact covered area per pixel)")

@@ -10,15 +10,13 @@
 #include <fmt/core.h>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/lcmlog/log_reader.hpp"
 #include "covtrack/lcmlog/replayer.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 
 namespace covtrack::cli {
 namespace {
-
-// Scripts notice a damaged log by this exit code; everything before the damage was published.
-constexpr int kExitDamagedLog = 3;
 
 struct ReplayArgs {
   std::string path;
@@ -103,7 +101,7 @@ int run_replay(const ReplayArgs& args) {
              "covtrack replay: warning: the log is damaged; {} events before and between the "
              "damaged ranges were replayed\n",
              summary->events_published);
-  return kExitDamagedLog;
+  return program::kExitDamagedInput;  // scripts notice; all before the damage was published
 }
 
 }  // namespace
@@ -112,16 +110,16 @@ void add_replay_command(CLI::App& app) {
   auto args = std::make_shared<ReplayArgs>();
   auto* cmd = app.add_subcommand("replay", "Publish the events of an LCM log file");
   cmd->add_option("FILE", args->path, "LCM log file")->required();
-  cmd->add_option("--speed", args->options.speed, "Speed factor; 0 = as fast as possible")
+  cmd->add_option("--speed,-s", args->options.speed, "Speed factor; 0 = as fast as possible")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(program::non_negative());
   cmd->add_flag("--loop", args->options.loop, "Start again at the end, until interrupted");
   cmd->add_option("--start", args->options.start_s, "Skip the first S seconds of the log")
-      ->check(CLI::NonNegativeNumber);
+      ->check(program::non_negative());
   cmd->add_option("--channels", args->options.channels,
                   "Regular expression matching whole channel names")
       ->capture_default_str();
-  cmd->add_option("--lcm-url", args->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or LCM's)");
+  cmd->add_option("--lcm-url,-u", args->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or LCM's)");
   cmd->callback([args] {
     if (const int code = run_replay(*args); code != 0) throw CLI::RuntimeError(code);
   });

@@ -54,14 +54,18 @@ ViewBackground::ViewBackground(const std::string& spec, cv::Size size, std::stri
       video_.emplace(spec, cv::CAP_FFMPEG);  // not every backend in turn, each complaining
     }
   } catch (const std::exception& e) {  // std::stoi, or OpenCV refusing the source
-    warning = fmt::format("background {}: {}; drawing on a plain background", spec, e.what());
+    warning = fmt::format("background {}: {}", spec, e.what());
     video_.reset();
-    return;
   }
-  if (!video_->isOpened()) {
-    warning = fmt::format("background {}: cannot open it as {}; drawing on a plain background", spec,
-                          is_camera_ ? "a camera" : "an image or a video");
+  if (video_ && !video_->isOpened()) {
+    warning = fmt::format("background {}: cannot open it as {}", spec,
+                          is_camera_ ? "a camera (is it plugged in and not in use?)" : "an image or a video");
     video_.reset();
+  }
+  // A camera asked for and not there makes the view pointless; a file is only scenery.
+  if (!video_) {
+    camera_unavailable_ = is_camera_;
+    if (!is_camera_) warning += "; drawing on a plain background";
   }
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // What `covtrack view` draws on: a plain colour, an image, a video file (looped) or a
-// camera (the video see-through case of seed 4.6.1). A source that cannot be opened or
-// stops delivering is reported once and replaced by the plain colour: the view goes on.
+// camera (the video see-through case of seed 4.6.1). A file that cannot be opened, or a
+// source that stops delivering, is reported once and replaced by the plain colour: the
+// view goes on. A camera that cannot be opened at the start ends the view.
 #include <optional>
 #include <string>
 
@@ -20,6 +21,8 @@ class ViewBackground {
   // The next frame at the view's size (a copy the caller may draw on). Sets `warning`
   // when the source fails now.
   cv::Mat next(std::string& warning);
+  // camera:N was asked for and could not be opened (`warning` says so): the view ends.
+  bool camera_unavailable() const { return camera_unavailable_; }
 
  private:
   cv::Size size_;
@@ -27,6 +30,7 @@ class ViewBackground {
   cv::Mat still_;
   std::optional<cv::VideoCapture> video_;
   bool is_camera_ = false;
+  bool camera_unavailable_ = false;
   std::string name_;
 };
 

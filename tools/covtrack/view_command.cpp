@@ -22,6 +22,7 @@
 #include <fmt/ranges.h>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
@@ -31,6 +32,7 @@
 #include "subscriber_summary.hpp"
 #include "view_background.hpp"
 #include "view_log.hpp"
+#include "view_video.hpp"
 #include "view_widgets.hpp"
 
 namespace covtrack::cli {
@@ -45,7 +47,7 @@ struct ViewArgs {
   std::string png_path;
   std::string video_path;
   std::string background;
-  double duration_s = 0;  // 0: until stopped (window), one frame (--png), 10 s (--video)
+  double duration_s = 0;  // 0: until stopped (window), one frame (--png), the whole --log or 10 s (--video)
   double fps = 30;
   double confidence = 0;
   client::ProjectionMethod method = client::ProjectionMethod::unscented;
@@ -100,6 +102,10 @@ int run_view(const ViewArgs& args) {
     return code;
   };
   const bool window = args.png_path.empty() && args.video_path.empty();
+  std::optional<VideoFormat> video_format;
+  if (!args.video_path.empty() && !(video_format = video_format_for(args.video_path)))
+    return fail_with(fmt::format("--video {}: name it .mp4 (H.264) or .webm (VP9), formats browsers play",
+                                 args.video_path), program::kExitUsageError);
   if (window && !std::getenv("DISPLAY"))
     return fail_with("no display (DISPLAY is not set): use --png FILE or --video FILE", 2);
   const auto model = load_regions_model(args.scene_path, args.confidence);
@@ -120,7 +126,7 @@ int run_view(const ViewArgs& args) {
     return fail_with(fmt::format("{}: {}", args.scene_path, r.error().message), 2);
   if (args.live) {
     auto sub = client::Subscriber::open({.lcm_url = args.lcm_url});
-    if (!sub) return fail_with(sub.error().message, 2);
+    if (!sub) return fail_with(sub.error().message, program::kExitRuntimeError);
     subscriber = std::move(*sub);
     // Streams the scene does not use are simply not in the graph.
     (void)subscriber->on_pose(".*", [&](const client::TrackedTransform& t) { mismatches.update(graph, t); });
@@ -146,20 +152,24 @@ int run_view(const ViewArgs& args) {
   const cv::Size size(model->camera.width_px, model->camera.height_px);
   std::string warning;
   ViewBackground background(args.background, size, warning);
+  if (background.camera_unavailable()) return fail_with(warning, program::kExitRuntimeError);
   std::optional<cv::VideoWriter> video;
   if (!args.video_path.empty()) {
-    video.emplace(args.video_path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), args.fps, size);
-    if (!video->isOpened()) return fail_with(fmt::format("cannot write video {}", args.video_path), 1);
+    auto opened = open_video(args.video_path, *video_format, args.fps, size);
+    if (!opened) return fail_with(opened.error().message, program::kExitRuntimeError);
+    video.emplace(std::move(*opened));
   }
   if (window) cv::namedWindow("covtrack view", cv::WINDOW_AUTOSIZE);
 
   install_stop_signals();
   // Scripts and tests wait for this line: from here on every message counts.
   if (subscriber) std::cerr << "covtrack view: following the streams on " << effective_lcm_url(args.lcm_url) << "\n";
-  const double duration_s = args.duration_s > 0 ? args.duration_s : (video ? 10.0 : 0.0);
-  // Offline into a file, nothing outside sets the pace: frames are rendered at their
-  // scene times as fast as they can be, and the same command gives the same pictures.
-  const bool virtual_clock = fixed && !window;
+  // A video of a log covers all of it; one of a scene or of live streams, 10 s.
+  const double duration_s = args.duration_s > 0 ? args.duration_s : (video && !log ? 10.0 : 0.0);
+  // Offline into a file (a scene or a log), nothing outside sets the pace: frames are
+  // rendered at their scene or log times as fast as they can be, and the same command
+  // gives the same pictures.
+  const bool virtual_clock = !args.live && !window;
   const auto start = std::chrono::steady_clock::now();
   const auto period = std::chrono::duration<double>(1.0 / args.fps);
   for (long frame_index = 0;; ++frame_index) {
@@ -225,25 +235,26 @@ void add_view_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("view", "Draw the objects' error regions over the camera view");
   cmd->add_option("SCENE", args->scene_path, "Scene file (config/scene_schema.md)")->required();
   cmd->add_flag("--live", args->live, "Tracked transforms from the daemon's streams, not the scene's values");
-  cmd->add_option("--lcm-url", args->lcm_url, "LCM URL for --live (default: $LCM_DEFAULT_URL or LCM's)");
+  cmd->add_option("--lcm-url,-u", args->lcm_url, "LCM URL for --live (default: $LCM_DEFAULT_URL or LCM's)");
   cmd->add_option("--log", args->log_path, "Follow a recorded session (LCM log) at its own time");
-  cmd->add_option("--speed", args->speed, "Speed factor of --log")->capture_default_str()->check(CLI::Range(0.01, 1000.0));
+  cmd->add_option("--speed,-s", args->speed, "Speed factor of --log")->capture_default_str()->check(program::in_range(0.01, 1000.0));
   cmd->add_option("--png", args->png_path, "Write one frame (at the end of --duration, if given) and exit");
-  cmd->add_option("--video", args->video_path, "Write the frames to this video file (MJPG AVI)");
+  cmd->add_option("--video", args->video_path,
+                  "Write the frames to this video file: FILE.mp4 (H.264) or FILE.webm (VP9), which browsers play");
   cmd->add_option("--background", args->background,
                   "#rrggbb, an image file, a video file (looped) or camera:N (default with --log: the "
                   "log's camera frames, if it has any)");
-  cmd->add_option("--duration", args->duration_s,
-                  "Seconds to run (default: until q/Esc/Ctrl-C; 10 for --video); offline (no --live, no --log) "
-                  "into a file, scene seconds rendered without waiting")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--fps", args->fps, "Frames per second")->capture_default_str()->check(CLI::Range(0.1, 240.0));
+  cmd->add_option("--duration,-d", args->duration_s,
+                  "Seconds to run (default: until q/Esc/Ctrl-C; for --video the whole --log, else 10); offline "
+                  "(no --live) into a file, scene or log seconds rendered without waiting")
+      ->check(program::non_negative());
+  cmd->add_option("--fps", args->fps, "Frames per second")->capture_default_str()->check(program::in_range(0.1, 240.0));
   cmd->add_option("--confidence", args->confidence, "Confidence of the regions (default: the scene's)")
-      ->check(CLI::Range(0.5, 0.9999));
+      ->check(program::in_range(0.5, 0.9999));
   const std::map<std::string, client::ProjectionMethod> methods = {
       {"unscented", client::ProjectionMethod::unscented}, {"linear", client::ProjectionMethod::linear}};
   cmd->add_option("--method", args->method, "Vertex projection: unscented or linear")
-      ->transform(CLI::CheckedTransformer(methods));
+      ->transform(program::one_of(methods));
   cmd->callback([args] {
     if (const int code = run_view(*args); code != 0) throw CLI::RuntimeError(code);
   });

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "covtrack/program/command_line.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"covtrack: scene error regions, the viewer, tag rendering and calibration (see README.md)", "covtrack"};
@@ -12,6 +13,6 @@ int main(int argc, char** argv) {
   covtrack::cli::add_view_command(app);
   covtrack::cli::add_render_tags_command(app);
   covtrack::cli::add_calibrate_fiducial_command(app);
-  CLI11_PARSE(app, argc, argv);
-  return 0;
+  covtrack::program::add_conventions(app);
+  return covtrack::program::parse_command_line(app, argc, argv).value_or(covtrack::program::kExitOk);
 }

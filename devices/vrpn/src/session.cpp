@@ -126,6 +126,12 @@ bool Session::send(std::string_view sender, std::string_view type, std::int64_t 
   return m.has_value();
 }
 
+bool Session::describe_udp(std::string_view host, int port, std::int64_t time_us) {
+  if (!peer_) return false;
+  queue({static_cast<std::int32_t>(port), kUdpDescription, time_us, udp_description(host)});
+  return true;
+}
+
 std::vector<std::uint8_t> Session::frame_for_udp(std::string_view sender, std::string_view type, std::int64_t time_us,
                                                  std::vector<std::uint8_t> payload) {
   std::vector<std::uint8_t> out;

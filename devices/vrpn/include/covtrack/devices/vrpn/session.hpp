@@ -60,6 +60,10 @@ class Session {
   // messages before the handshake, or for a sender or type not given at construction.
   bool send(std::string_view sender, std::string_view type, std::int64_t time_us,
             std::vector<std::uint8_t> payload);
+  // Queues a UDP description: the peer is to send its time-critical messages (tracker
+  // reports) to `host`:`port` (VRPN's clients send one after the handshake unless they
+  // connected over TCP only). False before ready().
+  bool describe_udp(std::string_view host, int port, std::int64_t time_us);
   // The same message framed on its own for a UDP datagram; empty when send() would refuse.
   std::vector<std::uint8_t> frame_for_udp(std::string_view sender, std::string_view type, std::int64_t time_us,
                                           std::vector<std::uint8_t> payload);

@@ -1,0 +1,174 @@
+// The vrpn driver against a scripted VRPN server on loopback: reports become poses with
+// the configured covariance; a report of an unlisted sensor, of the wrong size or with a
+// time stamp far from this host's clock is counted; a dropped connection makes every
+// reporting sensor LOST; a server that is no VRPN server, or serves no device of the
+// configured name, fails the driver with an error saying so.
+#include <gtest/gtest.h>
+
+#include <poll.h>
+#include <sys/socket.h>
+
+#include <array>
+#include <cmath>
+#include <functional>
+#include <thread>
+
+#include "capture_sink.hpp"
+#include "covtrack/devices/vrpn/message_names.hpp"
+#include "covtrack/devices/vrpn/session.hpp"
+#include "covtrack/devices/vrpn/socket.hpp"
+#include "covtrack/devices/vrpn/tracker_report.hpp"
+#include "covtrack/devices/vrpn/vrpn_driver.hpp"
+#include "covtrack/protocol/clock.hpp"
+
+using namespace covtrack;
+using namespace covtrack::vrpn;
+
+namespace {
+
+// Accepts one connection on a loopback port and runs `script` on it, on its own thread.
+class ScriptedServer {
+ public:
+  explicit ScriptedServer(std::function<void(const Socket&)> script) {
+    auto listener = listen_tcp("127.0.0.1", 0);
+    EXPECT_TRUE(listener);
+    sockaddr_in a{};
+    socklen_t size = sizeof a;
+    getsockname(listener->fd(), reinterpret_cast<sockaddr*>(&a), &size);
+    port = ntohs(a.sin_port);
+    thread_ = std::jthread([l = std::move(*listener), script](std::stop_token stop) {
+      pollfd p{l.fd(), POLLIN, 0};
+      while (!stop.stop_requested())
+        if (::poll(&p, 1, 20) > 0) {
+          Socket s(::accept(l.fd(), nullptr, nullptr));
+          script(s);
+          return;
+        }
+    });
+  }
+  int port = 0;
+
+ private:
+  std::jthread thread_;
+};
+
+// Reads from `s` into `session` until it has the peer's cookie (or 5 s pass).
+void handshake(const Socket& s, Session& session) {
+  send_all(s, session.take_output(), 2);
+  std::array<std::uint8_t, 4096> buffer{};
+  pollfd p{s.fd(), POLLIN, 0};
+  for (int i = 0; i < 250 && !session.ready(); ++i)
+    if (::poll(&p, 1, 20) > 0) {
+      const ssize_t n = ::recv(s.fd(), buffer.data(), buffer.size(), 0);
+      if (n <= 0) return;
+      (void)session.receive(std::span(buffer.data(), static_cast<std::size_t>(n)), now_us());
+    }
+  send_all(s, session.take_output(), 2);
+}
+
+Mat6 diagonal(double position_sigma, double rotation_sigma) {
+  Mat6 c = Mat6::Zero();
+  c.diagonal() << Vec3::Constant(position_sigma * position_sigma), Vec3::Constant(rotation_sigma * rotation_sigma);
+  return c;
+}
+
+VrpnConfig config_for(int port, const std::string& name = "Tracker0") {
+  VrpnConfig c;
+  c.device = "relay";
+  c.tracker = {name, "127.0.0.1", port};
+  c.covariance = diagonal(0.01, 0.02);
+  c.sensors = {{0, "head", diagonal(0.001, 0.003)}};
+  c.silence_timeout_s = 0.5;
+  c.sensor_timeout_s = 0;
+  return c;
+}
+
+Result<void> run_driver(const VrpnConfig& config, test::CaptureSink& sink) {
+  std::stop_source stop;
+  return make_vrpn_driver(config)->run(sink, stop.get_token());
+}
+
+}  // namespace
+
+TEST(VrpnDriver, ReportsBecomePosesOddOnesAreCountedAndADropIsLost) {
+  const std::int64_t t0 = now_us();
+  ScriptedServer server([&](const Socket& s) {
+    Session session({"Tracker0"}, {std::string(kTrackerPosQuat)});
+    handshake(s, session);
+    const Pose T = pose_from(Vec3(0.1, -0.2, 1.5), Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vec3(0, 0, 1))));
+    session.send("Tracker0", kTrackerPosQuat, t0, encode_pos_quat(report_of(0, T)));
+    session.send("Tracker0", kTrackerPosQuat, t0, encode_pos_quat(report_of(5, T)));  // not listed
+    auto short_report = encode_pos_quat(report_of(0, T));
+    short_report.resize(60);
+    session.send("Tracker0", kTrackerPosQuat, t0, short_report);
+    session.send("Tracker0", kTrackerPosQuat, t0 - 10'000'000, encode_pos_quat(report_of(0, T)));  // clock 10 s off
+    send_all(s, session.take_output(), 2);
+    // Then the server goes away: the socket closes as the script returns.
+  });
+  test::CaptureSink sink;
+  const auto result = run_driver(config_for(server.port), sink);
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("closed the connection"), std::string::npos) << result.error().message;
+  EXPECT_NE(result.error().message.find("sensors reported LOST"), std::string::npos);
+
+  ASSERT_EQ(sink.poses.size(), 3u) << "two reports of sensor 0, then LOST";
+  const PoseSample& first = sink.poses[0];
+  EXPECT_EQ(first.sensor, "head");
+  EXPECT_EQ(first.parent_frame, "world");
+  EXPECT_EQ(first.measurement_time_us, t0) << "the header's time, near this host's clock";
+  EXPECT_TRUE(first.T_parent_child.translation().isApprox(Vec3(0.1, -0.2, 1.5), 1e-15));
+  EXPECT_TRUE(first.covariance.isApprox(diagonal(0.001, 0.003))) << "the sensor's own covariance";
+  EXPECT_GE(sink.poses[1].measurement_time_us, t0) << "a time stamp 10 s off is replaced by the arrival time";
+  EXPECT_EQ(sink.poses[2].status, TrackingStatus::Lost);
+  EXPECT_TRUE(std::isinf(sink.poses[2].covariance(0, 0)));
+  EXPECT_EQ(sink.drops, 1) << "sensor 5 is not listed";
+  EXPECT_EQ(sink.errors, 2) << "the 60-byte report and the clock offset";
+}
+
+TEST(VrpnDriver, AServerWithoutTheNamedDeviceSaysNamesAreCaseSensitive) {
+  ScriptedServer server([](const Socket& s) {
+    Session session({"tracker0"}, {std::string(kTrackerPosQuat)});
+    handshake(s, session);
+    std::array<std::uint8_t, 4096> buffer{};
+    pollfd p{s.fd(), POLLIN, 0};
+    while (::poll(&p, 1, 2000) > 0 && ::recv(s.fd(), buffer.data(), buffer.size(), 0) > 0) {
+    }  // reads the pings for "Tracker0" and answers none, until the driver leaves
+  });
+  test::CaptureSink sink;
+  const auto result = run_driver(config_for(server.port), sink);
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("no device named 'Tracker0' answers"), std::string::npos)
+      << result.error().message;
+  EXPECT_NE(result.error().message.find("case-sensitive"), std::string::npos);
+  EXPECT_TRUE(sink.poses.empty());
+}
+
+TEST(VrpnDriver, APeerThatIsNoVrpnServerIsNamedAsSuch) {
+  ScriptedServer server([](const Socket& s) {
+    const std::string banner = "SSH-2.0-OpenSSH_9.2p1 Debian-2\r\n";
+    send_all(s, std::span(reinterpret_cast<const std::uint8_t*>(banner.data()), banner.size()), 2);
+    std::array<std::uint8_t, 64> buffer{};
+    pollfd p{s.fd(), POLLIN, 0};
+    while (::poll(&p, 1, 2000) > 0 && ::recv(s.fd(), buffer.data(), buffer.size(), 0) > 0) {
+    }
+  });
+  test::CaptureSink sink;
+  const auto result = run_driver(config_for(server.port), sink);
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("not a VRPN peer of major version 07: it sent 'SSH-2.0-OpenSSH"),
+            std::string::npos)
+      << result.error().message;
+}
+
+TEST(VrpnDriver, NoServerListeningIsAClearError) {
+  int port = 0;
+  {
+    ScriptedServer closed([](const Socket&) {});
+    port = closed.port;
+  }  // nothing listens there any more
+  test::CaptureSink sink;
+  const auto result = run_driver(config_for(port), sink);
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("is a vrpn_server running there?"), std::string::npos)
+      << result.error().message;
+}
