@@ -30,6 +30,9 @@ dpkg-deb -f "$deb" Depends | grep -q 'python3-numpy' || fail "Depends without py
 installed=1
 DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "$deb" "$dev" >"$tmp/apt.log" 2>&1 \
   || { cat "$tmp/apt.log"; fail "apt-get install"; }
+version=$(dpkg-deb -f "$deb" Version)
+[ "$(/usr/bin/covtrackd --version)" = "covtrackd $version" ] || fail "covtrackd --version: $(/usr/bin/covtrackd --version)"
+[ "$(/usr/bin/covtrack --version)" = "covtrack $version" ] || fail "covtrack --version: $(/usr/bin/covtrack --version)"
 dpkg-query -W -f='${Conffiles}\n' covtrack | grep -q '/etc/covtrack/covtrackd.toml' || fail "config is no conffile"
 cmp /etc/covtrack/covtrackd.toml "$src/config/sim.toml" || fail "/etc/covtrack/covtrackd.toml is not config/sim.toml"
 
