@@ -139,8 +139,9 @@ TEST(FullChain, WorldObjectScreenCovarianceMatchesMonteCarlo) {
     std::printf("head rotation sigma %4.1f deg: MC sigma (%.1f, %.1f) px; relative Frobenius "
                 "error: LCA + UT %.4f, seed additive matrix model %.4f\n",
                 c.head_rotation_deg, std::sqrt(mc(0, 0)), std::sqrt(mc(1, 1)), ours, seed);
-    // No edge is shared here (the world is the common ancestor), so the seed's model,
-    // converted to BODY before the same UT, agrees to first order: printed, not asserted.
+    // No edge is shared here (the world is the common ancestor), so the dissertation's
+    // model, converted to BODY before the same UT, agrees to first order: printed, not
+    // asserted.
     EXPECT_LT(ours, c.goal) << c.head_rotation_deg << " deg";
   }
 }

@@ -162,9 +162,9 @@ TEST(TransformGraph, HeadAttachedObjectMatchesMonteCarloAndIgnoresSharedEdges) {
 }
 
 TEST(TransformGraph, SeedModelsAgreeWithExactWithoutSharedEdges) {
-  // With the LCA at the root, root-based propagation is right: the seed's 16-element model,
-  // converted to BODY, must then equal the exact first-order result (a check of the
-  // 16-element implementation and of its conversion).
+  // With the LCA at the root, root-based propagation is right: the dissertation's
+  // 16-element model, converted to BODY, must then equal the exact first-order result (a
+  // check of the 16-element implementation and of its conversion).
   HeadWorld w;
   auto exact = w.graph.query("camera", "object", kT0, Propagation::LowestCommonAncestor);
   auto seed16 = w.graph.query("camera", "object", kT0, Propagation::SeedMatrix16);
