@@ -187,7 +187,7 @@ TEST(LenzDeadReckoning, ContainsTheTruthThroughSpeedChangesAndStops) {
   const double seed_inside = double(f.seed_inside) / f.samples;
   const double pose_inside = double(f.pose_inside) / f.samples;
   const double mean_width = f.width_sum / f.samples, mean_error = f.error_sum / f.samples;
-  std::printf("along-track 99%% interval holds the truth %.4f of %d samples (seed's rule: %.4f); "
+  std::printf("along-track 99%% interval holds the truth %.4f of %d samples (dissertation's rule: %.4f); "
               "6-D 99%% ellipsoid: %.4f; mean interval width %.4f m, mean |error| %.4f m (ratio %.2f)\n",
               inside, f.samples, seed_inside, pose_inside, mean_width, mean_error, mean_width / mean_error);
   EXPECT_GE(inside, 0.99);
