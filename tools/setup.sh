@@ -11,7 +11,8 @@ packages=(build-essential cmake pkg-config liblcm-dev liblcm-bin libeigen3-dev
           libopencv-calib3d-dev libopencv-imgcodecs-dev libopencv-videoio-dev libopencv-highgui-dev
           libapriltag-dev libqhull-dev libserial-dev libusb-1.0-0-dev libhidapi-dev xvfb xauth
           iproute2 util-linux python3-dev pybind11-dev python3-numpy python3-pytest
-          default-jdk-headless liblcm-java libjchart2d-java)
+          default-jdk-headless liblcm-java libjchart2d-java
+          file)  # file: cpack -G DEB finds the ELF files for dpkg-shlibdeps with it
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -28,7 +28,7 @@ const std::vector<DriverType>& driver_types() {
          sim::SimConfig config = sim::read_sim_config(device, name);
          return [config](std::uint64_t run) { return sim::make_sim_driver(config, run); };
        }},
-      {"lenz", "Lenz Digital Plus train tracker (LI101F / LI-USB): section occupancy and dead reckoning, seed 7.3",
+      {"lenz", "Lenz Digital Plus train tracker (LI101F / LI-USB): section occupancy and dead reckoning",
        [] {
          std::vector<const TableSpec*> specs{&lenz::lenz_device_spec()};
          for (const auto* s : lenz::layout_specs()) specs.push_back(s);

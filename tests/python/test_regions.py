@@ -56,8 +56,8 @@ def test_shipped_scene_regions_equal_the_command(source_dir, covtrack_cli, name)
 
 def test_options_equal_the_commands_options(source_dir, covtrack_cli):
     path = source_dir / "config" / "scenes" / "head_and_world.toml"
-    cli = cli_regions(covtrack_cli, path, "--method", "linear", "--propagation", "seed-matrix16", "--confidence", "0.99")
-    regions = covtrack.Scene(str(path), confidence=0.99).regions(method="linear", propagation="seed-matrix16")
+    cli = cli_regions(covtrack_cli, path, "--method", "linear", "--propagation", "osgar-matrix16", "--confidence", "0.99")
+    regions = covtrack.Scene(str(path), confidence=0.99).regions(method="linear", propagation="osgar-matrix16")
     for py, c in zip(regions, cli["objects"], strict=True):
         assert_same(py, c)
 

@@ -81,7 +81,7 @@ TEST_F(CliConventions, HelpListsExitCodesShortFlagsAndChoiceNames) {
   EXPECT_NE(run_covtrack("replay --help").out.find("-s,--speed"), std::string::npos);
   const std::string regions = run_covtrack("regions --help").out;
   EXPECT_NE(regions.find("{linear, unscented}"), std::string::npos) << regions;
-  EXPECT_NE(regions.find("{lca, seed-matrix16, seed-root}"), std::string::npos) << regions;
+  EXPECT_NE(regions.find("{lca, osgar-matrix16, osgar-root}"), std::string::npos) << regions;
   EXPECT_EQ(regions.find("->"), std::string::npos) << "enum values in the help:\n" << regions;
   const CliRun d = daemon("--help");
   EXPECT_EQ(d.exit_code, 0);

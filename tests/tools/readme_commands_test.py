@@ -8,7 +8,9 @@ code. The commands run in a scratch folder that links the checkout's folders and
 build (the README's `build/`), inside the private network namespace and a virtual X
 display this test is started in (CMake: netns_run.sh, xvfb-run).
 Skipped: tools/test.sh (this suite) and tools/demo.sh (setup and build, then the same
-daemon and echo as the next block).
+daemon and echo as the next block). The ```shell blocks (install into $HOME, a Debian
+package with sudo) are not run here: sdk_install_test and deb_package_test run the same
+commands into a scratch prefix and as root.
 Usage: readme_commands_test.py BUILD_DIR SOURCE_DIR
 """
 import os

@@ -59,7 +59,7 @@ TEST(RegionsCli, JsonDescribesEveryHullVertexAndConsistentRegions) {
 
 TEST(RegionsCli, HeadAttachedPanelErrorIsNotTheHeadTrackersAsInTheSeed) {
   const nlohmann::json exact = run_json();
-  const nlohmann::json seed = run_json("--propagation seed-matrix16");
+  const nlohmann::json seed = run_json("--propagation osgar-matrix16");
   const double exact_panel = object(exact, "hud_panel")["assessment_px"];
   const double seed_panel = object(seed, "hud_panel")["assessment_px"];
   const double exact_table = object(exact, "table")["assessment_px"];

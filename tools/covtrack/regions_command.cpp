@@ -164,10 +164,11 @@ void add_regions_command(CLI::App& app) {
       ->transform(program::one_of(methods));
   const std::map<std::string, client::Propagation> propagations = {
       {"lca", client::Propagation::LowestCommonAncestor},
-      {"seed-root", client::Propagation::SeedRoot},
-      {"seed-matrix16", client::Propagation::SeedMatrix16}};
+      {"osgar-root", client::Propagation::SeedRoot},
+      {"osgar-matrix16", client::Propagation::SeedMatrix16}};
   cmd->add_option("--propagation", args->propagation,
-                  "lca (exact, default), or the seed's seed-root / seed-matrix16 for comparison")
+                  "lca (exact, default); osgar-root or osgar-matrix16: osgAR's propagation from the root (docs/background.md), "
+                  "kept to compare against: it gives objects attached to a tracked frame an error they do not have")
       ->transform(program::one_of(propagations));
   cmd->add_option("--confidence", args->confidence, "Confidence of the regions (default: the scene's)")
       ->check(program::in_range(0.5, 0.9999));

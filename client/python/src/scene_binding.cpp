@@ -26,9 +26,9 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 client::Propagation propagation_of(const std::string& name) {
   if (name == "lca") return client::Propagation::LowestCommonAncestor;
-  if (name == "seed-root") return client::Propagation::SeedRoot;
-  if (name == "seed-matrix16") return client::Propagation::SeedMatrix16;
-  throw py::value_error("propagation must be 'lca', 'seed-root' or 'seed-matrix16', not '" + name + "'");
+  if (name == "osgar-root") return client::Propagation::SeedRoot;
+  if (name == "osgar-matrix16") return client::Propagation::SeedMatrix16;
+  throw py::value_error("propagation must be 'lca', 'osgar-root' or 'osgar-matrix16', not '" + name + "'");
 }
 
 client::ProjectionMethod method_of(const std::string& name) {
@@ -147,7 +147,7 @@ void bind_scene(py::module_& m) {
       "A tree of frames joined by uncertain transforms T_parent_child: static, or tracked by a stream. "
       "query(a, b) gives T_a_b with its BODY covariance, propagated through the lowest common ancestor.")
       .def(py::init([](const std::string& propagation) { return std::make_shared<TransformGraph>(propagation_of(propagation)); }),
-           py::arg("propagation") = "lca", "'lca' (exact), or the seed's 'seed-root' / 'seed-matrix16' for comparison")
+           py::arg("propagation") = "lca", "'lca' (exact), or osgAR's 'osgar-root' / 'osgar-matrix16' (docs/background.md) for comparison")
       .def("add_static", [](TransformGraph& g, const std::string& parent, const std::string& child,
                             const Eigen::Matrix4d& T, const Mat6& covariance) {
              check(g.add_static_edge(parent, child, rigid(T), covariance));
