@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Records the short Lenz session in tests/data/lenz_session.lcm: `covtrack emulate-lenz`
-# on the seed's ten-section layout (config/lenz_layout.toml), covtrackd's lenz driver at
+# on the ten-section layout (config/lenz_layout.toml), covtrackd's lenz driver at
 # 10 Hz, and `covtrack record` taking poses, truth (10 Hz), raw device bytes and status
 # for 20 s. Everything runs inside a private network namespace.
 # Usage: tools/record_lenz_session.sh [BUILD_DIR] [OUTPUT]

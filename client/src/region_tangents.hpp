@@ -1,8 +1,8 @@
 #pragma once
 // Common tangent lines of pairs of confidence ellipses (adjacent vertices of a
-// counter-clockwise hull), solved a block of pairs at a time. The inner region (seed 5.5.2)
-// needs the line with both ellipses on its outer side, the outer region's shortcut the line
-// with both on its inner side.
+// counter-clockwise hull), solved a block of pairs at a time. The inner region
+// (contraction) needs the line with both ellipses on its outer side, the outer region's
+// shortcut the line with both on its inner side.
 #include <vector>
 
 #include "covtrack/client/regions.hpp"

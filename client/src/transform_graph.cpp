@@ -211,7 +211,7 @@ Result<QueryResult> TransformGraph::query_detailed(const std::string& A, const s
       values[child] = v->value;
     }
 
-  // Root-to-frame chains (top-down) for the seed modes.
+  // Root-to-frame chains (top-down) for the root-based comparison modes.
   auto root_chain = [&](const std::vector<FrameIndex>& path) {
     std::vector<ChainFactor> f;
     for (auto it = path.rbegin(); it != path.rend(); ++it)

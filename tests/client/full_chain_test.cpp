@@ -137,10 +137,11 @@ TEST(FullChain, WorldObjectScreenCovarianceMatchesMonteCarlo) {
     const double seed = relative_frobenius(
         predicted(chain, cam, "table", kCorner, Propagation::SeedMatrix16), mc);
     std::printf("head rotation sigma %4.1f deg: MC sigma (%.1f, %.1f) px; relative Frobenius "
-                "error: LCA + UT %.4f, seed additive matrix model %.4f\n",
+                "error: LCA + UT %.4f, additive matrix model %.4f\n",
                 c.head_rotation_deg, std::sqrt(mc(0, 0)), std::sqrt(mc(1, 1)), ours, seed);
-    // No edge is shared here (the world is the common ancestor), so the seed's model,
-    // converted to BODY before the same UT, agrees to first order: printed, not asserted.
+    // No edge is shared here (the world is the common ancestor), so the dissertation's
+    // model, converted to BODY before the same UT, agrees to first order: printed, not
+    // asserted.
     EXPECT_LT(ours, c.goal) << c.head_rotation_deg << " deg";
   }
 }
@@ -157,8 +158,8 @@ TEST(FullChain, HeadAttachedObjectIgnoresTheHeadTracker) {
   const double seed = relative_frobenius(
       predicted(shaky, cam, "visor", kCorner, Propagation::SeedMatrix16), shaky_mc);
   std::printf("head-attached object, head rotation sigma 10 deg: MC sigma (%.2f, %.2f) px; "
-              "relative Frobenius error LCA + UT %.4f, seed additive matrix model %.1f\n",
+              "relative Frobenius error LCA + UT %.4f, additive matrix model %.1f\n",
               std::sqrt(shaky_mc(0, 0)), std::sqrt(shaky_mc(1, 1)), err, seed);
   EXPECT_LT(err, 0.01);
-  EXPECT_GT(seed, 1.0) << "the seed's root-based model should inflate it by far";
+  EXPECT_GT(seed, 1.0) << "the root-based additive matrix model should inflate it by far";
 }

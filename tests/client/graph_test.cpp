@@ -162,9 +162,9 @@ TEST(TransformGraph, HeadAttachedObjectMatchesMonteCarloAndIgnoresSharedEdges) {
 }
 
 TEST(TransformGraph, SeedModelsAgreeWithExactWithoutSharedEdges) {
-  // With the LCA at the root, root-based propagation is right: the seed's 16-element model,
-  // converted to BODY, must then equal the exact first-order result (a check of the
-  // 16-element implementation and of its conversion).
+  // With the LCA at the root, root-based propagation is right: the dissertation's
+  // 16-element model, converted to BODY, must then equal the exact first-order result (a
+  // check of the 16-element implementation and of its conversion).
   HeadWorld w;
   auto exact = w.graph.query("camera", "object", kT0, Propagation::LowestCommonAncestor);
   auto seed16 = w.graph.query("camera", "object", kT0, Propagation::SeedMatrix16);
@@ -184,8 +184,8 @@ TEST(TransformGraph, SeedModelsOverestimateHeadAttachedObject) {
   auto position_sigma = [](const Mat6& c) { return std::sqrt(c.topLeftCorner<3, 3>().trace()); };
   const double ratio16 = position_sigma(seed16->covariance) / position_sigma(exact->covariance);
   const double ratio_root = position_sigma(root->covariance) / position_sigma(exact->covariance);
-  std::printf("held object position sigma: exact %.2f mm, seed 16-element %.2f mm (x%.1f), "
-              "seed root %.2f mm (x%.1f)\n",
+  std::printf("held object position sigma: exact %.2f mm, 16-element root model %.2f mm (x%.1f), "
+              "root-based %.2f mm (x%.1f)\n",
               1e3 * position_sigma(exact->covariance), 1e3 * position_sigma(seed16->covariance),
               ratio16, 1e3 * position_sigma(root->covariance), ratio_root);
   EXPECT_GT(ratio16, 3.0);

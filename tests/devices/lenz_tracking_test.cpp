@@ -127,7 +127,8 @@ HonestyFigures run_simulated(const TrackLayout& layout, const std::vector<SpeedS
     return std::optional<std::vector<bool>>(occ);
   };
   reckoner.on_occupancy(occupancy_of(section), 0);
-  // The seed's estimator, for comparison: s = s0 + v t, +- (v_max - v) t.
+  // The dissertation's estimator (section 7.3), for comparison:
+  // s = s0 + v t, +- (v_max - v) t.
   double seed_entry_t = -1, seed_v = 0, seed_s0 = 0, seed_prev_entry = -1;
 
   HonestyFigures f;
@@ -186,12 +187,13 @@ TEST(LenzDeadReckoning, ContainsTheTruthThroughSpeedChangesAndStops) {
   const double seed_inside = double(f.seed_inside) / f.samples;
   const double pose_inside = double(f.pose_inside) / f.samples;
   const double mean_width = f.width_sum / f.samples, mean_error = f.error_sum / f.samples;
-  std::printf("along-track 99%% interval holds the truth %.4f of %d samples (seed's rule: %.4f); "
+  std::printf("along-track 99%% interval holds the truth %.4f of %d samples (dissertation's rule: %.4f); "
               "6-D 99%% ellipsoid: %.4f; mean interval width %.4f m, mean |error| %.4f m (ratio %.2f)\n",
               inside, f.samples, seed_inside, pose_inside, mean_width, mean_error, mean_width / mean_error);
   EXPECT_GE(inside, 0.99);
   EXPECT_GE(pose_inside, 0.99);
-  EXPECT_LT(seed_inside, inside);  // the seed's rule misses a train that slows down or stops
+  // The dissertation's rule misses a train that slows down or stops.
+  EXPECT_LT(seed_inside, inside);
   // Not absurdly wide: a uniform spread over the interval would give width / error = 4.
   EXPECT_LT(mean_width / mean_error, 8.0);
   // And narrower than "somewhere in the occupied section", the estimate without dead reckoning.

@@ -1,7 +1,8 @@
-// One frame of `covtrack view` at a time, on the shipped tool-box scene (the seed's
-// figures 1, 18 and 19): its scripted error rises and falls over a 12 s loop, so the
-// widgets must follow it: Level of Error up and back down without flicker, labels from
-// inside the drawers to leader lines and back, the pointer selecting the drawer under it.
+// One frame of `covtrack view` at a time, on the shipped tool-box scene (after the
+// dissertation's figures 1, 18 and 19, docs/background.md): its scripted error rises and
+// falls over a 12 s loop, so the widgets must follow it: Level of Error up and back down
+// without flicker, labels from inside the drawers to leader lines and back, the pointer
+// selecting the drawer under it.
 #include <gtest/gtest.h>
 
 #include <cmath>

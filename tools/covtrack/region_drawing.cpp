@@ -106,8 +106,8 @@ void draw_regions(cv::Mat& image, const RegionsReport& report, const WidgetFrame
   const bool selecting = widgets && widgets->pointer;
   for (std::size_t i = 0; i < report.objects.size(); ++i) {
     const client::ObjectRegions& r = report.objects[i].regions;
-    // Seed figure 19: the outer regions filled by likelihood; otherwise the Level-of-Error
-    // "region" augmentation shades where the object can be.
+    // As the dissertation's figure 19: the outer regions filled by likelihood; otherwise
+    // the Level-of-Error "region" augmentation shades where the object can be.
     if (selecting) fill_polygon(image, r.outer, likelihood_colour(widgets->likelihoods[i]), 0.35);
     else if (augmentation(i) == scene::Augmentation::region) fill_polygon(image, r.outer, kCyan, 0.3);
   }

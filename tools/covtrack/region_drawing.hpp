@@ -1,14 +1,14 @@
 #pragma once
-// Drawing a RegionsReport over an image, in the seed's colours: error ellipses blue, outer
-// regions green, inner regions white; the object's outline (the hull of its projected
-// vertices) grey; labels (yellow) placed by the seed's label placer; a legend in the
+// Drawing a RegionsReport over an image, in the dissertation's colours: error ellipses
+// blue, outer regions green, inner regions white; the object's outline (the hull of its
+// projected vertices) grey; labels (yellow) placed by the label placer; a legend in the
 // bottom-left corner. Used by `covtrack regions --png` and
 // `covtrack view`. With the view's widgets: each object's Level-of-Error augmentation
 // (outline: its outline bold cyan; region: its outer region shaded cyan; label: its
 // label listed, not anchored); with a pointer, the outer regions filled by selection
-// likelihood from yellow (0) to red (1) (seed figure 19) instead of the cyan shade, the
-// selected object outlined red, the pointer's region magenta, and the indirect targets
-// when the selection is ambiguous.
+// likelihood from yellow (0) to red (1) (as in the dissertation's figure 19) instead of the
+// cyan shade, the selected object outlined red, the pointer's region magenta, and the
+// indirect targets when the selection is ambiguous.
 #include <string>
 #include <vector>
 

@@ -1,6 +1,6 @@
 #pragma once
 // What `covtrack view` draws on: a plain colour, an image, a video file (looped) or a
-// camera (the video see-through case of seed 4.6.1). A file that cannot be opened, or a
+// camera (the video see-through case). A file that cannot be opened, or a
 // source that stops delivering, is reported once and replaced by the plain colour: the
 // view goes on. A camera that cannot be opened at the start ends the view.
 #include <optional>

@@ -1,9 +1,9 @@
 #pragma once
 // Each object's label in a frame: its text (name and assessment; short, so that it fits
-// inside more often: the likelihood is the fill's colour) and where the seed's label placer (5.6.3) puts it:
-// inside the inner region when it fits, else outside the outer region with a leader
-// line, else in the list in the top-left corner. The Level-of-Error "label"
-// augmentation does not rely on registration, so its label is always listed.
+// inside more often: the likelihood is the fill's colour) and where the label placer
+// (label_placer.hpp) puts it: inside the inner region when it fits, else outside the outer
+// region with a leader line, else in the list in the top-left corner. The Level-of-Error
+// "label" augmentation does not rely on registration, so its label is always listed.
 #include <string>
 #include <vector>
 

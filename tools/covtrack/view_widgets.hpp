@@ -1,8 +1,8 @@
 #pragma once
-// The seed's adaptive widgets for each frame of `covtrack view`: every object's
-// Level-of-Error choice (5.6.2; its hysteresis needs the frames before, so this object
-// lives as long as the view) and, when the scene has a pointer, each object's selection
-// likelihood and the selection it makes (chapter 6).
+// The adaptive widgets (docs/background.md) for each frame of `covtrack view`: every
+// object's Level-of-Error choice (5.6.2; its hysteresis needs the frames before, so this
+// object lives as long as the view) and, when the scene has a pointer, each object's
+// selection likelihood and the selection it makes (chapter 6).
 #include <optional>
 #include <vector>
 

@@ -9,8 +9,8 @@ namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kInch = 0.0254;
 
-// Figures from protocols.md B.4: best case, metal-free; only the IS-900's 1.5 mm is
-// confirmed by a source, the rest are the vendors' usual spec-sheet numbers.
+// Vendor spec-sheet figures: best case, metal-free; only the IS-900's 1.5 mm is
+// confirmed by a published measurement, the rest are the vendors' usual numbers.
 const std::array<ModelSpec, 5> kModels = {{
     {Model::Fastrak, Protocol::Fastrak, "fastrak", 0.03 * kInch, Vec3::Constant(0.15 * kDeg),
      120, true, 10, 0.004, 30 * kInch},

@@ -1,4 +1,4 @@
-// FASTRAK / IS-900 configuration (protocols.md B.1): ^Y reset, c (stop), u/U (units),
+// FASTRAK / IS-900 configuration (FASTRAK manual): ^Y reset, c (stop), u/U (units),
 // O<st>,2,11,...,1 (output list), S (status record, confirms the units), f (binary),
 // C (continuous).
 #include <fmt/format.h>

@@ -1,6 +1,6 @@
-// Flock of Birds configuration (protocols.md B.3): B (stop streaming), P 50 n (FBB
-// auto-configuration, the long reset), O 3 (examine position scaling: confirms the
-// units), P 35 g (group mode), ] per bird (POSITION/QUATERNION), @ (stream).
+// Flock of Birds configuration (laserBIRD guide, same RS-232 format): B (stop streaming),
+// P 50 n (FBB auto-configuration, the long reset), O 3 (examine position scaling: confirms
+// the units), P 35 g (group mode), ] per bird (POSITION/QUATERNION), @ (stream).
 #include <fmt/format.h>
 
 #include "covtrack/devices/serial6dof/flock_decoder.hpp"

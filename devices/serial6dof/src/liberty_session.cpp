@@ -1,4 +1,4 @@
-// LIBERTY / PATRIOT configuration (protocols.md B.2): ^Y reset, P (stop continuous),
+// LIBERTY / PATRIOT configuration (PDI SDK, VRPN): ^Y reset, P (stop continuous),
 // F1 (binary), ^V (who-am-I), U0/U1 (units), U (query, confirms the units),
 // O<st>,2,7,...,1 (output list), C (continuous).
 #include <fmt/format.h>

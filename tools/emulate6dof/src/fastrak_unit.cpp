@@ -1,4 +1,4 @@
-// An emulated FASTRAK / IS-900 (protocols.md B.1). Powers up polled, ASCII, inches,
+// An emulated FASTRAK / IS-900 (Polhemus FASTRAK manual). Powers up polled, ASCII, inches,
 // output list 2,4,1 (Euler: not emulated, so it sends no records until asked for 2,11).
 #include <algorithm>
 #include <map>

@@ -1,5 +1,6 @@
-// An emulated Flock of Birds (protocols.md B.3): binary commands with fixed argument
-// counts, 0xF0+address prefixes in group mode, answers to examine value.
+// An emulated Flock of Birds (Ascension laserBIRD guide, same RS-232 format): binary
+// commands with fixed argument counts, 0xF0+address prefixes in group mode, answers to
+// examine value.
 #include <set>
 
 #include "emulated_unit.hpp"

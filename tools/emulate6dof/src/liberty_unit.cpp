@@ -1,5 +1,6 @@
-// An emulated LIBERTY / PATRIOT (protocols.md B.2). Powers up polled, ASCII, inches.
-// Commands end with CR, except P (single record, also ends continuous output).
+// An emulated LIBERTY / PATRIOT (Polhemus PDI SDK, VRPN's Liberty driver). Powers up
+// polled, ASCII, inches. Commands end with CR, except P (single record, also ends
+// continuous output).
 #include <algorithm>
 #include <map>
 #include <string>

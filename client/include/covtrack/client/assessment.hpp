@@ -1,8 +1,8 @@
 #pragma once
-// Assessment (seed 5.3): one number per object for the size of its registration error.
-// A metric turns each projected hull vertex into a value; an aggregator turns the vertices
-// and their values into the object's number. Both are plain std::function, so applications
-// plug in their own.
+// Assessment (dissertation 5.3, docs/background.md): one number per object for the size of
+// its registration error. A metric turns each projected hull vertex into a value; an
+// aggregator turns the vertices and their values into the object's number. Both are plain
+// std::function, so applications plug in their own.
 #include <functional>
 #include <span>
 

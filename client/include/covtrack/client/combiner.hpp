@@ -1,7 +1,7 @@
 #pragma once
-// Chooses or fuses several estimates of the same transform (seed section 4.4,
-// TransformCombiner): e.g. a marker tracker seen by the camera and a room tracker that
-// both give T_world_object.
+// Chooses or fuses several estimates of the same transform (the dissertation's
+// TransformCombiner, section 4.4; docs/background.md): e.g. a marker tracker seen by the
+// camera and a room tracker that both give T_world_object.
 //
 // Rules common to every policy:
 // - an unbounded (LOST) candidate is never chosen while another one is bounded; the
@@ -37,7 +37,8 @@ class Combiner {
   // it received) or a fusion of them.
   using Callback = std::function<Combined(std::span<const UncertainPose> bounded)>;
 
-  // The seed's SmallestCovarianceCombiner.
+  // The dissertation's SmallestCovarianceCombiner: the estimate with the smallest
+  // covariance.
   static Combiner smallest(CovarianceSize size = CovarianceSize::TranslationTrace);
   // Covariance intersection (Julier & Uhlmann): consistent whatever the (unknown)
   // correlation between the candidates. Fuses the bounded candidates one after another.

@@ -1,12 +1,12 @@
 #pragma once
-// The seed's reference model (OSGAR dissertation, appendix B and section 4.9.1), kept to
-// compare against, never to use: each 4x4 transform carries a 16x16 covariance of its
+// The osgAR dissertation's model (appendix B and section 4.9.1; docs/background.md), kept
+// to compare against, never to use: each 4x4 transform carries a 16x16 covariance of its
 // matrix entries, errors are additive (M_true = M + dM), and the cumulative transform of
 // every frame is propagated down from the ROOT with eq. 29:
 //   N_j = N_i M_ij,   dN_j = N_i dM_ij + dN_i M_ij   (first order, independent errors).
 // The camera-to-object transform is then inv(N_camera) * N_object with the two cumulative
 // errors taken as independent (eq. 6), so edges shared by both root paths count twice:
-// the seed's "exaggerated estimates" flaw.
+// the "exaggerated estimates" flaw the dissertation describes.
 //
 // Matrices are vectorised column-major (vec(A X B) = (B^T kron A) vec(X)).
 #include <span>

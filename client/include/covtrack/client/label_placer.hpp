@@ -1,5 +1,6 @@
 #pragma once
-// Label placer (seed 5.6.3, 5.6.4). Each object gets a label box of a given size:
+// Label placer (dissertation 5.6.3-5.6.4, docs/background.md). Each object gets a label box
+// of a given size:
 //  1. inside its inner region when the box fits there entirely (the label is then surely
 //     on the object), unless the application asked never to cover objects;
 //  2. else outside its outer region (the label surely does not hide the object), at the

@@ -1,9 +1,10 @@
 #pragma once
-// Level of Error switch (seed 5.6.2): the application gives several augmentations of the
-// same object, from the one for the smallest error (drawn over the object) to the one for
-// the largest (clues only), and thresholds on the object's assessment between them. The
-// switch picks the augmentation for the current assessment, with hysteresis so an
-// assessment that hovers at a threshold does not make the view flicker:
+// Level of Error switch (dissertation 5.6.2, docs/background.md): the application gives
+// several augmentations of the same object, from the one for the smallest error (drawn over
+// the object) to the one for the largest (clues only), and thresholds on the object's
+// assessment between them. The switch picks the augmentation for the current assessment,
+// with hysteresis so an assessment that hovers at a threshold does not make the view
+// flicker:
 //  - up:   to level k as soon as assessment >= thresholds[k-1];
 //  - down: from level k only once assessment < thresholds[k-1] - margin.
 // An unbounded (+inf) or unknown (NaN) assessment selects the last level: with no bound

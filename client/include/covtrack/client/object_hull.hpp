@@ -1,10 +1,11 @@
 #pragma once
-// The vertices of an object's 3-D convex hull (seed 5.4): computed once per object, so the
-// per-frame projection handles only the points that can bound its screen region. Every
-// point of the 2-D hull of a projection is the image of a 3-D hull vertex, so nothing is
-// lost by dropping the others. That holds exactly for a pinhole (it maps segments to
-// segments); lens distortion bends them, so with strong distortion a dropped point near
-// the hull's silhouette can sit outside the screen hull by a fraction of a pixel.
+// The vertices of an object's 3-D convex hull (dissertation 5.4, docs/background.md):
+// computed once per object, so the per-frame projection handles only the points that can
+// bound its screen region. Every point of the 2-D hull of a projection is the image of a
+// 3-D hull vertex, so nothing is lost by dropping the others. That holds exactly for a
+// pinhole (it maps segments to segments); lens distortion bends them, so with strong
+// distortion a dropped point near the hull's silhouette can sit outside the screen hull by
+// a fraction of a pixel.
 #include <span>
 #include <vector>
 

@@ -3,8 +3,9 @@
 // uncertain pose T_camera_object in the BODY convention: T_true = T * Exp(xi),
 // xi ~ N(0, C), xi = [translation, rotation] (protocol/README.md).
 //
-// Two methods: the unscented transform over xi (seed appendix A; the default) and the
-// first-order linearisation (the fast path). Problems are reported in flags, never hidden.
+// Two methods: the unscented transform over xi (dissertation appendix A,
+// docs/background.md; the default) and the first-order linearisation (the fast path).
+// Problems are reported in flags, never hidden.
 #include <numbers>
 #include <span>
 #include <vector>
@@ -17,7 +18,8 @@ namespace covtrack::client {
 using Mat26 = Eigen::Matrix<double, 2, 6>;
 
 // Scaled unscented transform (Julier): lambda = alpha^2 (n + kappa) - n, n = 6.
-// The defaults (alpha 1, beta 0, kappa 3 - n) are the seed's plain UT: W0 = kappa/(n+kappa).
+// The defaults (alpha 1, beta 0, kappa 3 - n) are the dissertation's plain UT:
+// W0 = kappa/(n+kappa).
 struct UnscentedParams {
   double alpha = 1.0;
   double beta = 0.0;

@@ -1,5 +1,5 @@
 #pragma once
-// Screen-space error regions of an object (seed 5.2-5.5).
+// Screen-space error regions of an object (dissertation 5.2-5.5, docs/background.md).
 //
 //  - Error ellipse per vertex at a confidence p, drawn as a polygon that CONTAINS it: the
 //    image of a regular N-gon circumscribed about the unit circle (vertices at radius
@@ -7,7 +7,7 @@
 //    for a point A u on the ellipse, so the polygon lies within
 //        a (1/cos(pi/N) - 1)          (a = semi-major axis)
 //    of the ellipse; N is the smallest count meeting RegionOptions::max_polygon_error_px.
-//  - Outer region (expansion, 5.5.1): the seed's convex hull of the ellipses, as the
+//  - Outer region (expansion, 5.5.1): the convex hull of the ellipses, as the
 //    intersection of its support half-planes {n . x <= h(n)}, h(n) = max over the ellipses
 //    of n . c + sqrt(n^T S n). It contains every ellipse, so each vertex lies in it with
 //    probability >= p. Directions start 45 degrees apart; a gap is split while the corner
@@ -22,7 +22,7 @@
 //    ellipse and every corner passes the same distance test, so the guarantee is the same.
 //  - Inner region (contraction, 5.5.2): for each edge of the hull of the mean vertices, the
 //    line tangent to both adjacent ellipses on the interior side; the region is the
-//    intersection of the interior half-planes. Where the seed's construction (corners =
+//    intersection of the interior half-planes. Where the published construction (corners =
 //    intersections of consecutive tangent lines, then their hull) is well formed, the two
 //    are the same polygon, and it is used when checks show that (each line turns left of
 //    the last by less than pi and keeps an edge of positive length); otherwise the

@@ -1,7 +1,7 @@
 #pragma once
-// Selection under uncertainty (seed chapter 6). The pointer has its own error: its region
-// is a convex polygon around its position. Each object's region (normally its outer
-// region) gets a likelihood of being the one meant:
+// Selection under uncertainty (dissertation chapter 6, docs/background.md). The pointer has
+// its own error: its region is a convex polygon around its position. Each object's region
+// (normally its outer region) gets a likelihood of being the one meant:
 //  - by area (6.5.1): area(pointer ∩ object) / area(pointer), the chance that a pixel of
 //    the pointer falls on the object, both uniform; the intersection is linear-time;
 //  - by distance (6.5.2): max(0, 1 - |pointer - object centre| / object radius).

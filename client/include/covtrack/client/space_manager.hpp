@@ -1,8 +1,8 @@
 #pragma once
-// The space manager's list (seed 5.6.4): labels the label placer could not anchor to their
-// object go into a list in the screen's top-left corner, top to bottom, then in further
-// columns to the right when the screen's height runs out. Boxes already on the screen
-// are stepped over, so the list never overlaps them nor itself.
+// The space manager's list (dissertation 5.6.4, docs/background.md): labels the label
+// placer could not anchor to their object go into a list in the screen's top-left corner,
+// top to bottom, then in further columns to the right when the screen's height runs out.
+// Boxes already on the screen are stepped over, so the list never overlaps them nor itself.
 #include <span>
 #include <vector>
 

@@ -1,8 +1,9 @@
 #pragma once
-// Reads an LCM log file (protocols.md part C) event by event and says where it is
-// damaged. LCM's own reader (lcm_eventlog_read_next_event) skips garbage silently and
-// asserts on a bad channel length, so it can report neither a truncation nor a
-// corruption: this one validates every event and reports each damaged byte range.
+// Reads an LCM log file (no header; each event: sync word 0xEDA1DA01, big-endian numbers,
+// channel name, payload) event by event and says where it is damaged. LCM's own reader
+// (lcm_eventlog_read_next_event) skips garbage silently and asserts on a bad channel
+// length, so it can report neither a truncation nor a corruption: this one validates
+// every event and reports each damaged byte range.
 #include <cstddef>
 #include <cstdint>
 #include <optional>

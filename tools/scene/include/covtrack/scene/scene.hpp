@@ -33,8 +33,9 @@ struct SceneTransform {
   std::vector<Keyframe> keyframes;
 };
 
-// Level-of-Error augmentations `covtrack view` can draw (seed 5.6.2), from the one that
-// relies most on registration to the one that relies on it least.
+// Level-of-Error augmentations `covtrack view` can draw (dissertation 5.6.2,
+// docs/background.md), from the one that relies most on registration to the one that
+// relies on it least.
 enum class Augmentation { outline, region, label };
 const char* to_string(Augmentation a);
 
@@ -51,8 +52,8 @@ struct SceneObject {
 
 enum class Likelihood { area, distance };
 
-// A tracked pointer (seed chapter 6): a point of a frame, projected with its error, that
-// selects among the objects.
+// A tracked pointer (dissertation chapter 6): a point of a frame, projected with its error,
+// that selects among the objects.
 struct ScenePointer {
   std::string frame;
   Vec3 tip_m = Vec3::Zero();

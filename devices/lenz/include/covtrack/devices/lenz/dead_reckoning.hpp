@@ -1,8 +1,9 @@
 #pragma once
-// Where the locomotive can be, from section occupancy alone (seed 7.3, done honestly).
+// Where the locomotive can be, from section occupancy alone (the dissertation's model-train
+// tracker, section 7.3 in docs/background.md, done honestly).
 //
-// The seed estimates the speed from the time spent in the previous section, puts the
-// train at s0 + v t, and grows the uncertainty with (v_max - v) t. That misses a train
+// The dissertation estimates the speed from the time spent in the previous section, puts
+// the train at s0 + v t, and grows the uncertainty with (v_max - v) t. That misses a train
 // that slows down or stops, and lets the uncertainty run past the section that is
 // known to be occupied. Here the estimate is the set of positions the train can reach:
 // - the locomotive crossed into the section at a detection time, give or take the

@@ -1,5 +1,5 @@
 #pragma once
-// What covtrack knows about each tracker model: its static accuracy (protocols.md B.4),
+// What covtrack knows about each tracker model: its static accuracy (vendor spec sheets),
 // report rate and reset time. The defaults of the driver and of the emulator.
 #include <string_view>
 

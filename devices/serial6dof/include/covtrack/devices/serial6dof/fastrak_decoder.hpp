@@ -13,7 +13,8 @@
 namespace covtrack::serial6dof {
 
 // Output-list items after position (2) and quaternion (11), in list order
-// (protocols.md B.1). The driver always asks for 2, 11, then these, then 1 (CR LF).
+// (FASTRAK manual; IS-900 user guide). The driver always asks for 2, 11, then these,
+// then 1 (CR LF).
 enum class FastrakExtra { Timestamp = 21, Buttons = 22, Stylus = 16, Joystick = 23 };
 
 struct FastrakFormat {

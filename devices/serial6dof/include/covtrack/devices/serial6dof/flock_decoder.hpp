@@ -1,7 +1,8 @@
 #pragma once
-// Pure decoder of Ascension Flock of Birds POSITION/QUATERNION records (protocols.md
-// B.3): 7 phased 14-bit words (x, y, z, q0..q3; q0 scalar), plus the bird's FBB address
-// in group mode. Resyncs on the phasing bit (bit 7 set only in a record's first byte).
+// Pure decoder of Ascension Flock of Birds POSITION/QUATERNION records
+// (laserBIRD guide): 7 phased 14-bit words (x, y, z, q0..q3; q0 scalar), plus the bird's
+// FBB address in group mode. Resyncs on the phasing bit (bit 7 set only in a record's
+// first byte).
 #include <cstdint>
 #include <span>
 #include <string>

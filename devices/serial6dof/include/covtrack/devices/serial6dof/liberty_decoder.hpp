@@ -13,7 +13,7 @@
 
 namespace covtrack::serial6dof {
 
-// Output-list items after position (2) and quaternion (7) (protocols.md B.2).
+// Output-list items after position (2) and quaternion (7) (PDI SDK).
 enum class LibertyExtra { Timestamp = 8, FrameCount = 9, Stylus = 10 };
 
 struct LibertyFormat {

@@ -1,7 +1,7 @@
 #pragma once
 // The 14-bit "phasing" words of the Flock of Birds (and IS-900 items 18-20): each 16-bit
 // value keeps its top 14 bits, sent LS byte first, 7 bits per byte; only the first byte
-// of a record has bit 7 set (protocols.md B.3).
+// of a record has bit 7 set (laserBIRD guide).
 #include <cstdint>
 
 namespace covtrack::serial6dof {
