@@ -1,6 +1,7 @@
-// `covtrack regions` as a user runs it, on the shipped seed figure 10 scene: the JSON is
-// complete and self-consistent, the head-attached panel's error does not come from the
-// head tracker (unlike the seed's model), the picture is written, mistakes are reported.
+// `covtrack regions` as a user runs it, on the shipped scene of the dissertation's
+// figure 10: the JSON is complete and self-consistent, the head-attached panel's error
+// does not come from the head tracker (unlike the dissertation's root model), the
+// picture is written, mistakes are reported.
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -57,15 +58,15 @@ TEST(RegionsCli, JsonDescribesEveryHullVertexAndConsistentRegions) {
   }
 }
 
-TEST(RegionsCli, HeadAttachedPanelErrorIsNotTheHeadTrackersAsInTheSeed) {
+TEST(RegionsCli, HeadAttachedPanelErrorIsNotTheHeadTrackersAsInTheRootModel) {
   const nlohmann::json exact = run_json();
   const nlohmann::json seed = run_json("--propagation osgar-matrix16");
   const double exact_panel = object(exact, "hud_panel")["assessment_px"];
   const double seed_panel = object(seed, "hud_panel")["assessment_px"];
   const double exact_table = object(exact, "table")["assessment_px"];
-  std::printf("hud_panel error: exact %.2f px, seed model %.2f px (%.1fx); table %.2f px\n",
+  std::printf("hud_panel error: exact %.2f px, root model %.2f px (%.1fx); table %.2f px\n",
               exact_panel, seed_panel, seed_panel / exact_panel, exact_table);
-  // The seed's section 4.9.1 measured 5-78x too large on such a chain.
+  // The dissertation's section 4.9.1 model measured 5-78x too large on such a chain.
   EXPECT_GT(seed_panel, 5 * exact_panel);
   // The world object sees the 2-degree head tracker: far more error than the panel.
   EXPECT_GT(exact_table, 5 * exact_panel);
