@@ -67,10 +67,8 @@ Result<void> TransformGraph::add_edge(const std::string& parent, const std::stri
   const FrameIndex c = existing_child ? *existing_child : add_frame(child);
   tree_[tree_of(c)] = tree_of(p);
   for (const EdgeSource& source : edge.sources)
-    if (const auto* tracked = std::get_if<TrackedSource>(&source)) {
-      ++bound_streams_[tracked->stream.key()];
-      stream_parent_.emplace(tracked->stream.key(), parent);
-    }
+    if (const auto* tracked = std::get_if<TrackedSource>(&source))
+      bound_streams_.emplace(tracked->stream.key(), parent);
   frames_[c].parent = p;
   frames_[c].edge = std::move(edge);
   return {};
@@ -113,8 +111,8 @@ std::optional<std::string> TransformGraph::frame_mismatch(const TrackedTransform
 }
 
 std::optional<std::string> TransformGraph::mismatch_of(const StreamId& stream, const TrackedTransform& report) const {
-  const auto it = stream_parent_.find(stream.key());
-  if (it == stream_parent_.end() || report.parent_frame.empty() || report.parent_frame == it->second)
+  const auto it = bound_streams_.find(stream.key());
+  if (it == bound_streams_.end() || report.parent_frame.empty() || report.parent_frame == it->second)
     return std::nullopt;
   return "stream " + stream.key() + " reports its pose relative to frame '" + report.parent_frame +
          "', but the graph attaches it to frame '" + it->second +

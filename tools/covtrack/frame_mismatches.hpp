@@ -20,11 +20,10 @@ class FrameMismatches {
   // Feeds the report to the graph (streams the scene does not use are ignored there);
   // a refused one is told on stderr the first time for its stream.
   void update(client::TransformGraph& graph, const client::TrackedTransform& t) {
+    if (graph.update(t.stream, t)) return;
+    // Refused: only a frame mismatch is worth telling (an unbound stream is just unused).
     const auto mismatch = graph.frame_mismatch(t);
-    if (!mismatch) {
-      (void)graph.update(t.stream, t);
-      return;
-    }
+    if (!mismatch) return;
     std::lock_guard lock(mutex_);
     if (reported_parent_.emplace(t.stream.key(), t.parent_frame).second) std::cerr << "covtrack view: " << *mismatch << "\n";
   }

@@ -146,8 +146,8 @@ class TransformGraph {
   // representative. A cycle check is then one look-up instead of a walk to the root, which
   // made a long chain quadratic to load.
   std::vector<FrameIndex> tree_;
-  std::unordered_map<std::string, int> bound_streams_;     // StreamId::key() -> tracked sources
-  std::unordered_map<std::string, std::string> stream_parent_;  // StreamId::key() -> its edge's parent
+  // StreamId::key() of every stream an edge is bound to -> that edge's parent frame.
+  std::unordered_map<std::string, std::string> bound_streams_;
   std::map<std::string, TrackedTransform> latest_;         // by StreamId::key()
 };
 
