@@ -61,6 +61,14 @@ Decoded<device_status_t> decode_status(std::string_view channel, std::span<const
   return msg;
 }
 
+Decoded<device_claim_t> decode_claim(std::string_view channel, std::span<const std::byte> bytes) {
+  auto msg = decode_named<device_claim_t>(channel, bytes, kClaimPrefix, false);
+  if (!msg) return msg;
+  if (msg->stage != device_claim_t::STAGE_CLAIMING && msg->stage != device_claim_t::STAGE_HOLDING)
+    return reject(WireFault::BadValue, fmt::format("unknown stage {}", msg->stage));
+  return msg;
+}
+
 Decoded<image_t> decode_image(std::string_view channel, std::span<const std::byte> bytes) {
   return decode_named<image_t>(channel, bytes, kImagePrefix, false);
 }
@@ -73,6 +81,7 @@ std::optional<WireRejection> check_channel_message(std::string_view channel, std
   if (channel.starts_with(kPosePrefix)) return verdict(decode_pose(channel, bytes));
   if (channel.starts_with(kStatusPrefix)) return verdict(decode_status(channel, bytes));
   if (channel.starts_with(kImagePrefix)) return verdict(decode_image(channel, bytes));
+  if (channel.starts_with(kClaimPrefix)) return verdict(decode_claim(channel, bytes));
   if (channel.starts_with(kTruthPrefix))
     return verdict(decode_named<truth_pose_t>(channel, bytes, kTruthPrefix, true));
   if (channel.starts_with(kRawPrefix)) return verdict(decode_named<raw_bytes_t>(channel, bytes, kRawPrefix, false));

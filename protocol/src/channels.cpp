@@ -29,6 +29,7 @@ std::string truth_channel(std::string_view d, std::string_view s) { return join(
 std::string status_channel(std::string_view d) { return join(kStatusPrefix, d); }
 std::string raw_channel(std::string_view d) { return join(kRawPrefix, d); }
 std::string image_channel(std::string_view d) { return join(kImagePrefix, d); }
+std::string claim_channel(std::string_view d) { return join(kClaimPrefix, d); }
 
 std::optional<StreamId> parse_stream_channel(std::string_view channel, std::string_view prefix) {
   if (!channel.starts_with(prefix)) return std::nullopt;

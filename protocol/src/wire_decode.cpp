@@ -160,6 +160,7 @@ Decoded<Msg> decode_message(std::span<const std::byte> bytes) {
 template Decoded<pose_cov_t> decode_message(std::span<const std::byte>);
 template Decoded<truth_pose_t> decode_message(std::span<const std::byte>);
 template Decoded<device_status_t> decode_message(std::span<const std::byte>);
+template Decoded<device_claim_t> decode_message(std::span<const std::byte>);
 template Decoded<raw_bytes_t> decode_message(std::span<const std::byte>);
 template Decoded<image_t> decode_message(std::span<const std::byte>);
 

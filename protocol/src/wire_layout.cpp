@@ -1,5 +1,6 @@
 #include "wire_layout.hpp"
 
+#include <covtrack/device_claim_t.hpp>
 #include <covtrack/device_status_t.hpp>
 #include <covtrack/image_t.hpp>
 #include <covtrack/pose_cov_t.hpp>
@@ -29,6 +30,11 @@ constexpr Field kStatus[] = {
     {"instance_id", Kind::I64}, {"host", Kind::Label}, {"pid", Kind::I32}, {"heartbeat_period_us", Kind::I64},
 };
 
+constexpr Field kClaim[] = {
+    {"time_us", Kind::I64},     {"device", Kind::Name}, {"instance_id", Kind::I64}, {"host", Kind::Label},
+    {"pid", Kind::I32},         {"claimed_us", Kind::I64}, {"stage", Kind::I8},
+};
+
 constexpr Field kRaw[] = {
     {"time_us", Kind::I64}, {"device", Kind::Name}, {"direction", Kind::I8}, {"length", Kind::I32},
     {"data", Kind::Bytes},
@@ -55,6 +61,11 @@ const Layout& layout_of<truth_pose_t>() {
 template <>
 const Layout& layout_of<device_status_t>() {
   static const Layout l{"device_status_t", 0x7ec722603176c7fd, kStatus};
+  return l;
+}
+template <>
+const Layout& layout_of<device_claim_t>() {
+  static const Layout l{"device_claim_t", 0x33b158b34d7502e8, kClaim};
   return l;
 }
 template <>

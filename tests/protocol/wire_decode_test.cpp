@@ -87,6 +87,8 @@ TEST(WireLayout, FingerprintsAreLcmGensForEveryType) {
   EXPECT_EQ(wire::layout_of<truth_pose_t>().fingerprint, static_cast<std::uint64_t>(truth_pose_t::getHash()));
   EXPECT_EQ(wire::layout_of<device_status_t>().fingerprint,
             static_cast<std::uint64_t>(device_status_t::getHash()));
+  EXPECT_EQ(wire::layout_of<device_claim_t>().fingerprint,
+            static_cast<std::uint64_t>(device_claim_t::getHash()));
   EXPECT_EQ(wire::layout_of<raw_bytes_t>().fingerprint, static_cast<std::uint64_t>(raw_bytes_t::getHash()));
   EXPECT_EQ(wire::layout_of<image_t>().fingerprint, static_cast<std::uint64_t>(image_t::getHash()));
 }
@@ -281,6 +283,25 @@ TEST(ChannelMessages, HeartbeatValuesMustBeInRange) {
   EXPECT_EQ(bad([](device_status_t& s) { s.heartbeat_period_us = 0; }),
             "bad value: heartbeat_period_us 0 is outside 1000-3600000000");
   EXPECT_EQ(bad([](device_status_t& s) { s.host = "pc\x1b"; }).substr(0, 8), "bad text");
+}
+
+TEST(ChannelMessages, ClaimsDecodeOnTheirDevicesChannelWithAKnownStage) {
+  device_claim_t c{};
+  c.time_us = 1;
+  c.device = "dev";
+  c.instance_id = -5;
+  c.host = "pc";
+  c.pid = 42;
+  c.claimed_us = 7;
+  c.stage = device_claim_t::STAGE_HOLDING;
+  const auto d = decode_claim(claim_channel("dev"), encode(c));
+  ASSERT_TRUE(d) << d.error().describe();
+  EXPECT_EQ(encode(*d), encode(c));
+  EXPECT_EQ(decode_claim(claim_channel("other"), encode(c)).error().fault, WireFault::WrongChannel);
+  EXPECT_EQ(decode_claim(claim_channel("dev"), encode(status())).error().fault, WireFault::WrongType);
+  c.stage = 2;
+  EXPECT_EQ(decode_claim(claim_channel("dev"), encode(c)).error().describe(), "bad value: unknown stage 2");
+  EXPECT_EQ(check_channel_message(claim_channel("dev"), encode(c))->fault, WireFault::BadValue);
 }
 
 TEST(ChannelMessages, CheckOfAnyChannelKnowsEachKindAndLeavesOthersAlone) {

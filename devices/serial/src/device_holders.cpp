@@ -11,6 +11,13 @@
 
 namespace covtrack::serial {
 
+std::string describe_process(int pid) {
+  std::string name;
+  std::ifstream comm(fmt::format("/proc/{}/comm", pid));
+  std::getline(comm, name);
+  return name.empty() ? fmt::format("pid {}", pid) : fmt::format("{} (pid {})", name, pid);
+}
+
 std::vector<std::string> processes_holding(const std::string& path) {
   namespace fs = std::filesystem;
   std::vector<std::string> holders;
@@ -27,9 +34,7 @@ std::vector<std::string> processes_holding(const std::string& path) {
       if (target.st_ino != device.st_ino || target.st_dev != device.st_dev ||
           target.st_rdev != device.st_rdev)
         continue;
-      std::string name;
-      std::ifstream(process.path() / "comm") >> name;
-      holders.push_back(fmt::format("{} (pid {})", name.empty() ? "?" : name, pid));
+      holders.push_back(describe_process(std::stoi(pid)));
       break;
     }
     ec.clear();  // a process that ended or hides its descriptors: go on

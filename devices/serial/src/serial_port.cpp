@@ -68,16 +68,10 @@ Result<void> check_device_kind(const std::string& path) {
   return fail("is not a character device, so not a serial device");
 }
 
-// libserial 1.0.0 calls close(-1) before formatting errno, so its message for every failed
-// open is "Bad file descriptor". Repeat the open (it just failed, so it fails again the
-// same way, almost always) to report the real errno.
-std::string open_failure_reason(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-  if (fd >= 0) {
-    ::close(fd);
-    return "refused once, then opened (device busy or being re-plugged?)";
-  }
-  const int error = errno;
+int open_plain(const std::string& path) { return ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC); }
+
+// Why open() failed with `error`, with what to do about it.
+std::string open_error_text(const std::string& path, int error) {
   const std::string text = std::strerror(error);
   if (error == EBUSY) {
     const std::vector<std::string> holders = processes_holding(path);
@@ -88,10 +82,22 @@ std::string open_failure_reason(const std::string& path) {
   return text;
 }
 
+// libserial 1.0.0 calls close(-1) before formatting errno, so its message for every failed
+// open is "Bad file descriptor". Repeat the open (it just failed, so it fails again the
+// same way, almost always) to report the real errno.
+std::string open_failure_reason(const std::string& path) {
+  const int fd = open_plain(path);
+  if (fd >= 0) {
+    ::close(fd);
+    return "refused once, then opened (device busy or being re-plugged?)";
+  }
+  return open_error_text(path, errno);
+}
+
 }  // namespace
 
-SerialPort::SerialPort(std::unique_ptr<LibSerial::SerialPort> port, std::string path)
-    : port_(std::move(port)), path_(std::move(path)), fd_(port_->GetFileDescriptor()) {}
+SerialPort::SerialPort(std::unique_ptr<LibSerial::SerialPort> port, std::string path, std::optional<PortLock> lock)
+    : lock_(std::move(lock)), port_(std::move(port)), path_(std::move(path)), fd_(port_->GetFileDescriptor()) {}
 
 SerialPort::~SerialPort() { close_safely(); }
 
@@ -100,6 +106,12 @@ Result<std::unique_ptr<SerialPort>> SerialPort::open(const SerialSettings& setti
   if (!is_supported_baud(settings.baud))
     return fail(where(fmt::format("unsupported baud rate {}", settings.baud)));
   if (auto kind = check_device_kind(settings.path); !kind) return fail(where(kind.error().message));
+  // Before the open: opening a port already toggles its modem lines, which resets some units.
+  auto lock = PortLock::acquire(settings.path, settings.lock_dir);
+  if (!lock) return fail(where(lock.error().message));
+  const int lock_fd = open_plain(settings.path);
+  if (lock_fd < 0) return fail(where(fmt::format("cannot open: {}", open_error_text(settings.path, errno))));
+  if (auto locked = lock->flock_port(lock_fd); !locked) return fail(where(locked.error().message));
 
   auto lib_port = std::make_unique<LibSerial::SerialPort>();
   try {
@@ -115,7 +127,7 @@ Result<std::unique_ptr<SerialPort>> SerialPort::open(const SerialSettings& setti
     return fail(where(fmt::format("cannot open: {}", open_failure_reason(settings.path))));
   }
   // From here on the wrapper owns the port, so every failure path tears down safely.
-  std::unique_ptr<SerialPort> port(new SerialPort(std::move(lib_port), settings.path));
+  std::unique_ptr<SerialPort> port(new SerialPort(std::move(lib_port), settings.path, std::move(*lock)));
   try {
     port->port_->SetBaudRate(to_libserial(settings.baud));
     port->port_->SetCharacterSize(LibSerial::CharacterSize::CHAR_SIZE_8);

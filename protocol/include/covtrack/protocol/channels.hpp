@@ -11,6 +11,8 @@ inline constexpr std::string_view kTruthPrefix = "covtrack/truth/";
 inline constexpr std::string_view kStatusPrefix = "covtrack/status/";
 inline constexpr std::string_view kRawPrefix = "covtrack/raw/";
 inline constexpr std::string_view kImagePrefix = "covtrack/image/";
+// Between daemons only: who publishes a device (device_claim_t).
+inline constexpr std::string_view kClaimPrefix = "covtrack/claim/";
 
 // LCM limits channel names to 63 characters; with the longest prefix and a '/',
 // device and sensor names of at most 23 characters each always fit.
@@ -24,6 +26,7 @@ std::string truth_channel(std::string_view device, std::string_view sensor);
 std::string status_channel(std::string_view device);
 std::string raw_channel(std::string_view device);
 std::string image_channel(std::string_view device);
+std::string claim_channel(std::string_view device);
 
 struct StreamId {
   std::string device;
@@ -36,7 +39,7 @@ struct StreamId {
 std::optional<StreamId> parse_pose_channel(std::string_view channel);
 // The stream of a channel `prefix<device>/<sensor>` (pose, truth), or nothing.
 std::optional<StreamId> parse_stream_channel(std::string_view channel, std::string_view prefix);
-// The device of a channel `prefix<device>` (status, raw, image), or nothing.
+// The device of a channel `prefix<device>` (status, raw, image, claim), or nothing.
 std::optional<std::string> parse_device_channel(std::string_view channel, std::string_view prefix);
 
 }  // namespace covtrack

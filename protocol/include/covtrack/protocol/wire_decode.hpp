@@ -16,6 +16,7 @@
 #include <string>
 #include <string_view>
 
+#include <covtrack/device_claim_t.hpp>
 #include <covtrack/device_status_t.hpp>
 #include <covtrack/image_t.hpp>
 #include <covtrack/pose_cov_t.hpp>
@@ -32,7 +33,7 @@ enum class WireFault {
   BadName,        // a device or sensor name that breaks the naming rules (channels.hpp)
   BadText,        // a string that is not UTF-8, or a frame, driver or encoding name with a control character
   DecoderFailed,  // LCM's decoder refused or threw (after the walk found nothing)
-  BadValue,       // a heartbeat field out of its range (state, rate, period)
+  BadValue,       // a heartbeat or claim field out of its range (state, rate, period, stage)
   BadChannel,     // a covtrack channel whose name breaks the rules (protocol/README.md, "Messages")
   WrongChannel,   // the message names another device or sensor than its channel
 };
@@ -47,7 +48,7 @@ struct WireRejection {
 template <typename Msg>
 using Decoded = std::expected<Msg, WireRejection>;
 
-// One of the five covtrack message types, checked as above.
+// One of the six covtrack message types, checked as above.
 template <typename Msg>
 Decoded<Msg> decode_message(std::span<const std::byte> bytes);
 

@@ -6,7 +6,10 @@
 
 namespace covtrack::serial {
 
-// "name (pid N)" for each process with a descriptor on the device that `path` names
+// "covtrackd (pid 1234)": the name from /proc/<pid>/comm, or "pid 1234" when it cannot be read.
+std::string describe_process(int pid);
+
+// describe_process() for each process with a descriptor on the device that `path` names
 // (symlinks followed). Processes whose descriptors this one may not read are not listed.
 std::vector<std::string> processes_holding(const std::string& path);
 

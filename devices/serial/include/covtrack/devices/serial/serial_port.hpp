@@ -9,13 +9,18 @@
 // poll(), and the teardown is made safe before libserial gets to restore settings. The
 // same destructor abort follows opening a path that is not a terminal (a typo naming a
 // file), so open() checks the path's kind first.
+//
+// A port is used by one program at a time: open() takes its lock (port_lock.hpp, the UUCP
+// lock file and flock) and fails naming the holder when another program has it.
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
+#include "covtrack/devices/serial/port_lock.hpp"
 #include "covtrack/protocol/result.hpp"
 
 namespace LibSerial {
@@ -28,6 +33,7 @@ struct SerialSettings {
   std::string path;            // e.g. /dev/ttyUSB0, or a symlink to a pseudo-terminal
   int baud = 19200;            // one of the standard rates (see is_supported_baud)
   bool rts_cts = false;        // hardware flow control; 8N1 always
+  std::string lock_dir = default_lock_dir();  // where the UUCP lock file goes
 };
 
 class SerialPort {
@@ -51,10 +57,12 @@ class SerialPort {
   bool disconnected() const { return disconnected_; }
 
  private:
-  SerialPort(std::unique_ptr<LibSerial::SerialPort> port, std::string path);
+  SerialPort(std::unique_ptr<LibSerial::SerialPort> port, std::string path, std::optional<PortLock> lock = {});
   Error disconnect_error(const std::string& what);
   void close_safely() noexcept;
 
+  // Declared first, so destroyed last: the lock file goes once the port is closed.
+  std::optional<PortLock> lock_;
   std::unique_ptr<LibSerial::SerialPort> port_;
   std::string path_;
   int fd_ = -1;
