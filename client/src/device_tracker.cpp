@@ -1,9 +1,25 @@
 #include "covtrack/client/device_tracker.hpp"
 
+#include <fmt/format.h>
+
 namespace covtrack::client {
 
+std::string DevicePublisher::name() const { return fmt::format("{}/{}", host, pid); }
+
+std::string second_publisher_warning(const std::string& device, const DeviceState& state) {
+  const auto& who = state.publishing;
+  if (who.size() < 2) return {};
+  static constexpr const char* kCount[] = {"", "", "two", "three", "four"};
+  std::string names;
+  for (std::size_t i = 0; i < who.size(); ++i)
+    names += (i == 0 ? "" : i + 1 == who.size() ? " and " : ", ") + who[i].name();
+  return fmt::format("device {} published by {} daemons: {}", device,
+                     who.size() < std::size(kCount) ? kCount[who.size()] : std::to_string(who.size()), names);
+}
+
 void DeviceTracker::on_heartbeat(const device_status_t& status, std::int64_t now_us) {
-  auto [it, is_new] = instances_.try_emplace(status.instance_id, Instance{now_us, now_us});
+  auto [it, is_new] = instances_.try_emplace(
+      status.instance_id, Instance{{status.instance_id, status.host, status.pid}, now_us, now_us});
   if (is_new) {
     // The one before is already forgotten (silent for long): it was a restart.
     if (newest_ && !instances_.contains(*newest_)) ++state_.restarts;
@@ -38,9 +54,11 @@ void DeviceTracker::count_publishers() {
   if (!newest_) return;
   const auto newest = instances_.find(*newest_);
   if (newest == instances_.end()) return;
-  int heard = 0;
-  for (const auto& [id, instance] : instances_) heard += instance.last_us >= newest->second.first_us;
-  state_.publishers = heard;
+  state_.publishing.clear();
+  for (const auto& [id, instance] : instances_)
+    if (instance.last_us >= newest->second.first_us && id != *newest_) state_.publishing.push_back(instance.who);
+  state_.publishing.push_back(newest->second.who);
+  state_.publishers = static_cast<int>(state_.publishing.size());
 }
 
 }  // namespace covtrack::client

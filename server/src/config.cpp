@@ -36,6 +36,13 @@ const TableSpec& daemon_spec() {
           {"stop_timeout_s", ValueType::Float, "s", "2",
            "at SIGINT/SIGTERM, longest wait for the device threads; a device still running then "
            "is named and the daemon exits anyway, with code 4", 0.1, 600},
+          {"claim_wait_s", ValueType::Float, "s", "0.5",
+           "at start, how long to wait for another daemon that already publishes one of the devices "
+           "(it answers a claim at once; 0: do not wait, and rely on the heartbeats)", 0, 10},
+          {"allow_duplicate_publishers", ValueType::Boolean, "", "false",
+           "publish a device that another daemon already publishes (both then publish it, and say "
+           "so); false: such a device is not started, and a device claimed first elsewhere is given "
+           "up; --allow-duplicate-publishers sets it"},
       }};
   return spec;
 }
@@ -50,6 +57,8 @@ DaemonSettings read_daemon(TableReader& top) {
   d.restart_backoff_initial_s = r.number("restart_backoff_initial_s", d.restart_backoff_initial_s);
   d.restart_backoff_max_s = r.number("restart_backoff_max_s", d.restart_backoff_max_s);
   d.stop_timeout_s = r.number("stop_timeout_s", d.stop_timeout_s);
+  d.claim_wait_s = r.number("claim_wait_s", d.claim_wait_s);
+  d.allow_duplicate_publishers = r.boolean("allow_duplicate_publishers", d.allow_duplicate_publishers);
   if (d.restart_backoff_max_s < d.restart_backoff_initial_s)
     r.error("restart_backoff_max_s", "must not be below restart_backoff_initial_s");
   return d;

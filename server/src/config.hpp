@@ -16,6 +16,10 @@ struct DaemonSettings {
   double restart_backoff_initial_s = 0.5;
   double restart_backoff_max_s = 10.0;
   double stop_timeout_s = 2.0;  // longest wait for the device threads at a stop
+  // One publisher per device (device_ownership.hpp): how long a starting daemon listens
+  // for another that holds its devices, and whether it publishes them anyway.
+  double claim_wait_s = 0.5;
+  bool allow_duplicate_publishers = false;
 };
 
 struct DeviceConfig {

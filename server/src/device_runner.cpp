@@ -69,6 +69,11 @@ void DeviceRunner::start() {
 
 void DeviceRunner::request_stop() { thread_.request_stop(); }
 
+void DeviceRunner::release() {
+  released_ = true;
+  request_stop();
+}
+
 bool DeviceRunner::join_until(std::chrono::steady_clock::time_point deadline) {
   if (!thread_.joinable()) return true;
   {

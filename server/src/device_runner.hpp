@@ -23,6 +23,9 @@ class DeviceRunner {
 
   void start();
   void request_stop();
+  // Another daemon publishes this device: stop the driver and send no more heartbeats.
+  void release();
+  bool released() const { return released_; }
   // Waits for the thread until `deadline`; false if it is still running then (its
   // driver is blocked in a call that ignores the stop request). A true join never blocks.
   bool join_until(std::chrono::steady_clock::time_point deadline);
@@ -43,6 +46,7 @@ class DeviceRunner {
   DaemonSettings settings_;
 
   std::atomic<std::int8_t> state_{device_status_t::STATE_STARTING};
+  std::atomic<bool> released_{false};
   std::atomic<std::int64_t> reports_{0}, errors_{0}, resyncs_{0}, drops_{0}, restarts_{0};
   std::mutex text_mutex_;  // guards the two texts below
   std::string last_error_;

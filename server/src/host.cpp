@@ -20,9 +20,21 @@ Host::~Host() {
   for (auto& r : runners_) r->join();
 }
 
-void Host::start() {
-  for (auto& r : runners_) r->start();
+void Host::start(const std::set<std::string>& not_started) {
+  for (auto& r : runners_) {
+    if (not_started.contains(r->name())) r->release();
+    else r->start();
+  }
   heartbeat_thread_ = std::jthread([this](std::stop_token stop) { publish_heartbeats(stop); });
+}
+
+bool Host::give_up(const std::string& device) {
+  bool any_left = false;
+  for (auto& r : runners_) {
+    if (r->name() == device) r->release();
+    any_left = any_left || !r->released();
+  }
+  return any_left;
 }
 
 std::vector<std::string> Host::stop() {
@@ -47,6 +59,7 @@ void Host::publish_heartbeats(std::stop_token stop) {
   const auto period_us = duration_cast<microseconds>(period).count();
   for (auto next = steady_clock::now() + period; sleep_until(stop, next); next += period)
     for (auto& r : runners_) {
+      if (r->released()) continue;  // another daemon publishes it
       device_status_t status = r->heartbeat();
       status.instance_id = identity_.instance_id;
       status.host = identity_.host;

@@ -1,6 +1,7 @@
 #pragma once
 // Hosts every configured device and publishes their heartbeats.
 #include <memory>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -21,7 +22,12 @@ class Host {
 
   // Before start(): every published pose also goes to `tap` (see Publisher::tap_poses).
   void tap_poses(Publisher::PoseTap tap) { publisher_.tap_poses(std::move(tap)); }
-  void start();
+  // Starts every device but those named in `not_started` (another daemon publishes them).
+  void start(const std::set<std::string>& not_started = {});
+  // Stops the device's driver and its heartbeats for good; false when no device of this
+  // host is left running.
+  bool give_up(const std::string& device);
+  const PublisherIdentity& identity() const { return identity_; }
   // Asks every device and the heartbeat to stop, and waits for each device's thread up
   // to daemon.stop_timeout_s in all. Returns a line per device whose thread is still
   // running then ("device 'cam' (fiducial) did not stop within 2.0 s"): its driver is

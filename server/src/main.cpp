@@ -3,12 +3,15 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <set>
+#include <pthread.h>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include "config.hpp"
 #include "covtrack/program/command_line.hpp"
+#include "device_ownership.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 #include "host.hpp"
 #include "stop_signals.hpp"
@@ -18,7 +21,21 @@ namespace {
 using namespace covtrack::program;
 constexpr const char* kSignalNote =
     "A stop signal before the devices start ends covtrackd at once, by that signal (status 130 or 143 in a "
-    "shell). Exit code 4 names the stuck device on the log; the daemon exits anyway.";
+    "shell). Exit code 4 names the stuck device on the log; the daemon exits anyway. Exit code 1 also when "
+    "another daemon already publishes every configured device (the log names it).";
+
+// The signal that came before the devices started ends the daemon by that signal.
+[[noreturn]] void end_by(int signal) {
+  std::cerr << "covtrackd: " << (signal == SIGINT ? "SIGINT" : "SIGTERM")
+            << " before the devices started; nothing was started\n";
+  std::signal(signal, SIG_DFL);
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, signal);
+  pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
+  std::raise(signal);
+  std::_Exit(kExitRuntimeError);  // not reached
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -28,11 +45,13 @@ int main(int argc, char** argv) {
 
   CLI::App app{"covtrackd: tracker daemon publishing pose + covariance over LCM", "covtrackd"};
   std::string config_path, lcm_url, log_level = "info";
-  bool check_only = false, print_schema = false;
+  bool check_only = false, print_schema = false, allow_duplicates = false;
   app.add_option("--config,-c", config_path, "daemon config (TOML; a file or a pipe), e.g. config/sim.toml");
   app.add_option("--lcm-url,-u", lcm_url, "LCM URL (overrides the config's daemon.lcm_url)");
   app.add_flag("--check", check_only, "validate the config, open every file and device it names, and exit");
   app.add_flag("--print-schema", print_schema, "print the config schema (Markdown) and exit");
+  app.add_flag("--allow-duplicate-publishers", allow_duplicates,
+               "publish devices that another daemon already publishes (sets daemon.allow_duplicate_publishers)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   add_conventions(app, kSignalNote);
@@ -90,16 +109,45 @@ int main(int argc, char** argv) {
     host.tap_poses([server = vrpn_server.get()](const std::string& device, const covtrack::PoseSample& s) {
       server->offer(device, s);
     });
-  host.start();
-  spdlog::info("covtrackd: {} device(s) publishing on {}", config->devices.size(), url);
+
+  // One publisher per device: claim them, and start only those no other daemon holds.
+  std::vector<std::string> names;
+  for (const auto& d : config->devices) names.push_back(d.name);
+  const covtrack::server::ClaimSettings claim{config->daemon.claim_wait_s,
+                                              config->daemon.allow_duplicate_publishers || allow_duplicates};
+  covtrack::server::DeviceOwnership ownership(**lcm, host.identity(), names, claim,
+                                              [&host](const std::string& device, const std::string& why) {
+                                                spdlog::error("covtrackd: device '{}' stopped: {}", device, why);
+                                                if (!host.give_up(device)) covtrack::server::signal_nothing_left();
+                                              });
+  std::optional<int> early_signal;
+  const auto refused = ownership.claim([&](std::chrono::milliseconds t) {
+    early_signal = covtrack::server::wait_for_stop_signal(stop_signals, t);
+    return !early_signal;
+  });
+  if (!refused) end_by(*early_signal);
+  std::set<std::string> not_started;
+  for (const auto& [device, why] : *refused) {
+    spdlog::error("covtrackd: device '{}' not started: {}", device, why);
+    not_started.insert(device);
+  }
+  if (not_started.size() == names.size()) {
+    std::cerr << "covtrackd: every configured device is published by another daemon; nothing was started\n";
+    return kExitRuntimeError;
+  }
+  host.start(not_started);
+  spdlog::info("covtrackd: {} device(s) publishing on {}", names.size() - not_started.size(), url);
 
   const int signal = covtrack::server::wait_for_stop_signal(stop_signals);
-  spdlog::info("covtrackd: {} received, stopping", signal == SIGINT ? "SIGINT" : "SIGTERM");
+  if (signal == covtrack::server::kNothingLeftSignal)
+    spdlog::error("covtrackd: every device is now published by another daemon; stopping");
+  else
+    spdlog::info("covtrackd: {} received, stopping", signal == SIGINT ? "SIGINT" : "SIGTERM");
   if (const auto stuck = host.stop(); !stuck.empty()) {
     for (const auto& line : stuck) spdlog::error("covtrackd: {}; exiting anyway", line);
     spdlog::shutdown();  // flushes the log
     // Without unwinding: the host would wait for the stuck thread in its destructor.
     std::_Exit(kExitDeviceDidNotStop);
   }
-  return 0;
+  return signal == covtrack::server::kNothingLeftSignal ? kExitRuntimeError : 0;
 }

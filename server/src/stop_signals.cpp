@@ -3,6 +3,8 @@
 #include <pthread.h>
 #include <unistd.h>
 
+#include <cerrno>
+
 namespace covtrack::server {
 namespace {
 
@@ -35,6 +37,7 @@ sigset_t block_stop_signals() {
   sigemptyset(&stop_signals);
   sigaddset(&stop_signals, SIGINT);
   sigaddset(&stop_signals, SIGTERM);
+  sigaddset(&stop_signals, kNothingLeftSignal);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   return stop_signals;
 }
@@ -44,5 +47,19 @@ int wait_for_stop_signal(const sigset_t& stop_signals) {
   while (sigwait(&stop_signals, &signal) != 0) {}
   return signal;
 }
+
+std::optional<int> wait_for_stop_signal(const sigset_t& stop_signals, std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(end - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return std::nullopt;
+    const timespec ts{static_cast<time_t>(left.count() / 1'000'000'000), static_cast<long>(left.count() % 1'000'000'000)};
+    const int signal = sigtimedwait(&stop_signals, nullptr, &ts);
+    if (signal > 0) return signal;
+    if (errno == EAGAIN) return std::nullopt;  // EINTR: another signal's handler ran; wait on
+  }
+}
+
+void signal_nothing_left() { ::kill(::getpid(), kNothingLeftSignal); }
 
 }  // namespace covtrack::server

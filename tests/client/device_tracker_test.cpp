@@ -6,6 +6,7 @@
 #include "covtrack/client/device_tracker.hpp"
 
 using covtrack::client::DeviceTracker;
+using covtrack::client::second_publisher_warning;
 
 namespace {
 
@@ -13,6 +14,8 @@ covtrack::device_status_t heartbeat(std::int64_t instance) {
   covtrack::device_status_t s{};
   s.device = "dev";
   s.instance_id = instance;
+  s.host = "pc" + std::to_string(instance);
+  s.pid = static_cast<std::int32_t>(100 + instance);
   s.heartbeat_period_us = 1'000'000;
   return s;
 }
@@ -53,11 +56,15 @@ TEST(DeviceTracker, TwoInstancesThatBothGoOnAreTwoPublishers) {
     d.check(t * 1'000'000 + 600'000);
   }
   EXPECT_EQ(d.state().publishers, 2);
+  EXPECT_EQ(second_publisher_warning("dev", d.state()), "device dev published by two daemons: pc7/107 and pc9/109");
   for (std::int64_t t = 7; t <= 12; ++t) {  // the first one stops: the second goes on alone
     d.on_heartbeat(heartbeat(9), t * 1'000'000 + 500'000);
     d.check(t * 1'000'000 + 600'000);
   }
   EXPECT_EQ(d.state().publishers, 1);
+  ASSERT_EQ(d.state().publishing.size(), 1u);
+  EXPECT_EQ(d.state().publishing[0].name(), "pc9/109");
+  EXPECT_EQ(second_publisher_warning("dev", d.state()), "");
   EXPECT_EQ(d.state().restarts, 0);  // it was never a restart
 }
 

@@ -1,5 +1,6 @@
 // `covtrack devices`: what is attached (serial ports, USB, HID), which of it covtrack
-// supports or commonly carries a supported tracker, and a config snippet for each.
+// supports or commonly carries a supported tracker, and a config snippet for each; a
+// serial port in use says by whom.
 #include <algorithm>
 #include <memory>
 
@@ -7,12 +8,24 @@
 
 #include "commands.hpp"
 #include "covtrack/discovery/attached_devices.hpp"
+#include "covtrack/devices/serial/device_holders.hpp"
+#include "covtrack/devices/serial/port_lock.hpp"
 #include "covtrack/discovery/known_devices.hpp"
 
 namespace covtrack::cli {
 namespace {
 
 using namespace covtrack::discovery;
+
+// "  [in use by covtrackd (pid 1234)]": the port's lock file, else the processes that have
+// it open (read from /proc, without opening the port: an open can reset a unit).
+std::string held_by(const std::string& port) {
+  std::string holder = serial::lock_file_holder(port, serial::default_lock_dir());
+  if (holder.empty()) {
+    for (const auto& p : serial::processes_holding(port)) holder += (holder.empty() ? "" : ", ") + p;
+  }
+  return holder.empty() ? "" : "  [in use by " + holder + "]";
+}
 
 std::string ids(std::uint16_t vendor, std::uint16_t product) {
   return fmt::format("{:04x}:{:04x}", vendor, product);
@@ -27,8 +40,8 @@ int run_devices(bool snippets) {
   for (const auto& s : found.serial) {
     const std::string path = s.by_id.empty() ? s.path : s.by_id;
     const KnownDevice* known = s.vendor_id ? recognise(*s.vendor_id, *s.product_id) : nullptr;
-    fmt::print("  {}{}{}\n", path, s.vendor_id ? "  (USB " + ids(*s.vendor_id, *s.product_id) + ")" : "",
-               known ? "  -> " + known->name : "");
+    fmt::print("  {}{}{}{}\n", path, s.vendor_id ? "  (USB " + ids(*s.vendor_id, *s.product_id) + ")" : "",
+               known ? "  -> " + known->name : "", held_by(s.path));
     if (known) configs.push_back(config_snippet(*known, path));
   }
 

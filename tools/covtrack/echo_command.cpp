@@ -9,6 +9,7 @@
 #include <iostream>
 #include <map>
 #include <numbers>
+#include <set>
 #include <thread>
 
 #include <fmt/format.h>
@@ -96,12 +97,19 @@ std::string device_line(const std::string& name, const client::DeviceState& d) {
   if (!d.reachable)
     line += fmt::format("  UNREACHABLE: no heartbeat for {:.1f} s, its streams LOST",
                         1e-6 * static_cast<double>(now_us() - d.last_heard_us));
-  if (d.publishers > 1)
-    line += fmt::format("  {} PUBLISHERS (another daemon publishes this device)", d.publishers);
+  if (d.publishers > 1) line += "  " + client::second_publisher_warning(name, d);
   if (d.restarts > 0) line += fmt::format("  daemon restarted {} time(s)", d.restarts);
   if (!st.detail.empty()) line += "  (" + printable(st.detail) + ")";
   if (!st.last_error.empty()) line += "  last error: " + printable(st.last_error);
   return line + "\n";
+}
+
+// Once per device and set of publishers, on stderr (also in --json mode, which has no table).
+void warn_second_publishers(const client::Subscriber& sub, std::set<std::string>& warned) {
+  for (const auto& [name, device] : sub.devices()) {
+    const std::string warning = client::second_publisher_warning(name, device);
+    if (!warning.empty() && warned.insert(warning).second) std::cerr << "covtrack echo: " << warning << "\n";
+  }
 }
 
 double steady_now_s() {
@@ -167,6 +175,7 @@ int run_echo(const EchoOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   auto next_table = start + std::chrono::milliseconds(tty ? 200 : 1000);
   RateMeter rates(steady_now_s());
+  std::set<std::string> warned;
   auto print_table = [&] {
     const std::string t = table(**sub, rates);
     if (tty) std::cout << "\x1b[H\x1b[2J";  // redraw in place
@@ -185,6 +194,7 @@ int run_echo(const EchoOptions& o) {
                                  kSilenceHint.count(), effective_lcm_url(o.subscriber.lcm_url),
                                  o.subscriber.pattern);
     }
+    warn_second_publishers(**sub, warned);
     if (!o.json && now >= next_table) {
       next_table += std::chrono::milliseconds(tty ? 200 : 1000);
       print_table();

@@ -239,6 +239,18 @@ void bind_subscriber(py::module_& m) {
       .def_readonly("reachable", &DeviceState::reachable,
                     "a heartbeat within the last 3 periods; when not, its streams are reported LOST")
       .def_readonly("publishers", &DeviceState::publishers, "2 or more: several daemons publish it")
+      .def_property_readonly(
+          "publishing",
+          [](const DeviceState& d) {
+            std::vector<std::string> names;
+            for (const auto& p : d.publishing) names.push_back(p.name());
+            return names;
+          },
+          "\"host/pid\" of each daemon that publishes it, the newest last")
+      .def_property_readonly(
+          "second_publisher_warning",
+          [](const DeviceState& d) { return covtrack::client::second_publisher_warning(d.status.device, d); },
+          "\"device X published by two daemons: host/pid and host/pid\", or empty")
       .def_readonly("restarts", &DeviceState::restarts, "daemon restarts seen")
       .def_readonly("last_heard_us", &DeviceState::last_heard_us)
       .def_property_readonly("state", [](const DeviceState& d) { return state_name(d.status.state); },

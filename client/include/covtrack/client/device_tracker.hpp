@@ -7,18 +7,32 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include <covtrack/device_status_t.hpp>
 
 namespace covtrack::client {
+
+// One daemon instance that publishes a device, as its heartbeats name it.
+struct DevicePublisher {
+  std::int64_t instance_id = 0;
+  std::string host;
+  std::int32_t pid = 0;
+  std::string name() const;  // "host/pid"
+};
 
 struct DeviceState {
   device_status_t status;          // the last accepted heartbeat
   std::int64_t last_heard_us = 0;  // when it arrived (CLOCK_REALTIME, this client's clock)
   bool reachable = true;           // a heartbeat within the last kMissedHeartbeats periods
   int publishers = 1;              // instance ids heard since the newest one appeared: 2+ is a second publisher
+  std::vector<DevicePublisher> publishing;  // those instances, the newest last
   std::int64_t restarts = 0;       // instances that fell silent once a newer one took over
 };
+
+// "device rig published by two daemons: pc1/1234 and pc2/99", or empty with one publisher.
+std::string second_publisher_warning(const std::string& device, const DeviceState& state);
 
 class DeviceTracker {
  public:
@@ -32,6 +46,7 @@ class DeviceTracker {
 
  private:
   struct Instance {
+    DevicePublisher who;
     std::int64_t first_us = 0;
     std::int64_t last_us = 0;
     bool overlapped = false;  // heard after a newer instance appeared: a second publisher, not a restart
