@@ -102,8 +102,14 @@ class HeartbeatLog {
   std::size_t count(pid_t pid) const {
     return static_cast<std::size_t>(std::count_if(heard_.begin(), heard_.end(), [&](const auto& s) { return s.pid == pid; }));
   }
-  // The senders of the heartbeats sent after `time_us` (one host: one clock). Those sent
-  // earlier may arrive later, from our socket's queue.
+  // Waits for `n` heartbeats of `pid` sent after `time_us` (one host: one clock).
+  bool sent_after(pid_t pid, std::int64_t time_us, int n) {
+    return until([&](const auto& heard) {
+      return std::count_if(heard.begin(), heard.end(), [&](const auto& s) { return s.pid == pid && s.time_us > time_us; }) >= n;
+    });
+  }
+  // The senders of the heartbeats sent after `time_us`. Those sent earlier may arrive
+  // later, from our socket's queue.
   std::set<pid_t> pids_sent_after(std::int64_t time_us) const {
     std::set<pid_t> out;
     for (const auto& s : heard_)
@@ -200,7 +206,7 @@ TEST(Ownership, TwoDaemonsStartedAtOnceLeaveExactlyOnePublisher) {
 
   // From the loser's exit on, heartbeats come from the winner alone, which keeps running.
   const std::int64_t exited_us = now_us();
-  ASSERT_TRUE(heartbeats.more_from(winner->pid(), 5)) << winner->output();
+  ASSERT_TRUE(heartbeats.sent_after(winner->pid(), exited_us, 5)) << winner->output();
   EXPECT_EQ(heartbeats.pids_sent_after(exited_us), std::set<pid_t>{winner->pid()});
   EXPECT_FALSE(winner->process->wait(0)) << winner->output();
 }
@@ -223,7 +229,7 @@ TEST(Ownership, WithoutAClaimWaitTheLaterClaimGivesTheDeviceUpWhenTheHeartbeatsM
   EXPECT_NE(said.find("every device is now published by another daemon"), std::string::npos) << said;
 
   const std::int64_t exited_us = now_us();
-  ASSERT_TRUE(heartbeats.more_from(first.pid(), 5));
+  ASSERT_TRUE(heartbeats.sent_after(first.pid(), exited_us, 5));
   EXPECT_EQ(heartbeats.pids_sent_after(exited_us), std::set<pid_t>{first.pid()});
 }
 
