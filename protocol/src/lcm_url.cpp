@@ -19,6 +19,8 @@ std::string fix_hint() {
          "or pass another URL with --lcm-url (for example memq:// inside one process).";
 }
 
+}  // namespace
+
 // udpm://GROUP:PORT?options -> the group and port; LCM's defaults where missing.
 Result<sockaddr_in> parse_udpm(const std::string& url) {
   std::string rest = url.substr(std::strlen("udpm://"));
@@ -45,7 +47,6 @@ Result<sockaddr_in> parse_udpm(const std::string& url) {
     return fail("LCM URL '" + url + "': " + host + " is not a multicast group (224.0.0.0/4)");
   return addr;
 }
-}  // namespace
 
 std::string effective_lcm_url(const std::string& url) {
   if (!url.empty()) return url;

@@ -28,17 +28,30 @@ std::string describe_daemon(const std::string& host, std::int32_t pid, std::int6
   return fmt::format("{}/{} (instance {:016x})", host, pid, static_cast<std::uint64_t>(instance_id));
 }
 
+Result<std::unique_ptr<DeviceOwnership>> DeviceOwnership::open(lcm::LCM& lcm, const std::string& url,
+                                                               PublisherIdentity identity,
+                                                               const std::vector<std::string>& devices,
+                                                               ClaimSettings settings, GiveUp give_up) {
+  std::unique_ptr<DeviceOwnership> o(
+      new DeviceOwnership(lcm, std::move(identity), devices, settings, std::move(give_up)));
+  if (url.starts_with("udpm://")) {
+    auto listener = ClaimListener::open(url);
+    if (!listener) return std::unexpected(listener.error());
+    o->listener_ = std::move(*listener);
+  } else {
+    for (const auto prefix : {kClaimPrefix, kStatusPrefix})
+      o->subscriptions_.push_back(
+          lcm.subscribe(std::string(prefix) + any_of(devices), &DeviceOwnership::on_lcm_message, o.get()));
+  }
+  o->thread_ = std::jthread([raw = o.get()](std::stop_token stop) { raw->listen(stop); });
+  return o;
+}
+
 DeviceOwnership::DeviceOwnership(lcm::LCM& lcm, PublisherIdentity identity, const std::vector<std::string>& devices,
                                  ClaimSettings settings, GiveUp give_up)
     : lcm_(lcm), identity_(std::move(identity)), settings_(settings), give_up_(std::move(give_up)),
       claimed_us_(now_us()) {
   for (const auto& d : devices) devices_[d];
-  if (devices.empty()) return;
-  subscriptions_.push_back(
-      lcm_.subscribe(std::string(kClaimPrefix) + any_of(devices), &DeviceOwnership::on_claim, this));
-  subscriptions_.push_back(
-      lcm_.subscribe(std::string(kStatusPrefix) + any_of(devices), &DeviceOwnership::on_status, this));
-  thread_ = std::jthread([this](std::stop_token stop) { listen(stop); });
 }
 
 DeviceOwnership::~DeviceOwnership() {
@@ -50,9 +63,31 @@ DeviceOwnership::~DeviceOwnership() {
 }
 
 void DeviceOwnership::listen(std::stop_token stop) {
+  if (listener_) {
+    while (!stop.stop_requested())
+      if (auto m = listener_->receive(kPollMs)) on_message(m->channel, m->bytes);
+    return;
+  }
   pollfd pfd{lcm_.getFileno(), POLLIN, 0};
   while (!stop.stop_requested())
     if (::poll(&pfd, 1, kPollMs) > 0) lcm_.handle();
+}
+
+void DeviceOwnership::on_lcm_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  on_message(channel, bytes_of(rbuf->data, rbuf->data_size));
+}
+
+// Only our devices' channels count; the listener lets every device's through.
+void DeviceOwnership::on_message(const std::string& channel, std::span<const std::byte> bytes) {
+  if (channel.starts_with(kClaimPrefix)) {
+    if (!devices_.contains(channel.substr(kClaimPrefix.size()))) return;
+    const auto claim = decode_claim(channel, bytes);
+    if (claim) on_claim(*claim);
+    else spdlog::debug("covtrackd: ignored a claim on {}: {}", channel, claim.error().describe());
+  } else if (channel.starts_with(kStatusPrefix)) {
+    if (!devices_.contains(channel.substr(kStatusPrefix.size()))) return;
+    if (const auto status = decode_status(channel, bytes)) on_status(*status);
+  }
 }
 
 std::optional<std::map<std::string, std::string>> DeviceOwnership::claim(const Wait& wait) {
@@ -117,53 +152,47 @@ void DeviceOwnership::send_claim(const std::string& device, std::int8_t stage) {
   lcm_.publish(claim_channel(device), &claim);
 }
 
-void DeviceOwnership::on_claim(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  const auto claim = decode_claim(channel, bytes_of(rbuf->data, rbuf->data_size));
-  if (!claim) {
-    spdlog::debug("covtrackd: ignored a claim on {}: {}", channel, claim.error().describe());
-    return;
-  }
-  if (claim->instance_id == identity_.instance_id) return;  // our own, looped back
+void DeviceOwnership::on_claim(const device_claim_t& claim) {
+  if (claim.instance_id == identity_.instance_id) return;  // our own, looped back
   std::optional<std::string> given_up;
   {
     std::lock_guard lock(mutex_);
-    Device& device = devices_[claim->device];
-    Other& other = device.others[claim->instance_id];
-    other.claimed_us = claim->claimed_us;
-    other.host = claim->host;
-    other.pid = claim->pid;
-    other.holding = other.holding || claim->stage == device_claim_t::STAGE_HOLDING;
+    Device& device = devices_[claim.device];
+    Other& other = device.others[claim.instance_id];
+    other.claimed_us = claim.claimed_us;
+    other.host = claim.host;
+    other.pid = claim.pid;
+    other.holding = other.holding || claim.stage == device_claim_t::STAGE_HOLDING;
     if (device.stage != Stage::Holding) return;  // a claimant decides at the end of its wait
-    if (claim->stage == device_claim_t::STAGE_CLAIMING) {
-      send_claim(claim->device, device_claim_t::STAGE_HOLDING);  // the answer: we hold it
+    if (claim.stage == device_claim_t::STAGE_CLAIMING) {
+      send_claim(claim.device, device_claim_t::STAGE_HOLDING);  // the answer: we hold it
       return;
     }
-    if (!comes_first(claim->instance_id, other) || settings_.allow_duplicates) {
-      name_once(claim->device, claim->instance_id, other);
+    if (!comes_first(claim.instance_id, other) || settings_.allow_duplicates) {
+      name_once(claim.device, claim.instance_id, other);
       return;
     }
     device.stage = Stage::Refused;
-    given_up = "covtrackd on " + describe_daemon(other.host, other.pid, claim->instance_id) +
+    given_up = "covtrackd on " + describe_daemon(other.host, other.pid, claim.instance_id) +
                " publishes it too and claimed it first (" +
                fmt::format("{:.3f} s before this daemon", 1e-6 * static_cast<double>(claimed_us_ - other.claimed_us)) +
                "); this daemon gives it up";
   }
-  give_up_(claim->device, *given_up);
+  give_up_(claim.device, *given_up);
 }
 
-void DeviceOwnership::on_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  const auto status = decode_status(channel, bytes_of(rbuf->data, rbuf->data_size));
-  if (!status || status->instance_id == identity_.instance_id) return;
+void DeviceOwnership::on_status(const device_status_t& status) {
+  if (status.instance_id == identity_.instance_id) return;  // our own, looped back
   std::lock_guard lock(mutex_);
-  Device& device = devices_[status->device];
-  Other& other = device.others[status->instance_id];
+  Device& device = devices_[status.device];
+  Other& other = device.others[status.instance_id];
   other.holding = true;
-  other.host = status->host;
-  other.pid = status->pid;
+  other.host = status.host;
+  other.pid = status.pid;
   // Two holders: ours goes out so that the later of the two learns it and gives up.
   if (device.stage != Stage::Holding) return;
-  name_once(status->device, status->instance_id, other);
-  send_claim(status->device, device_claim_t::STAGE_HOLDING);
+  name_once(status.device, status.instance_id, other);
+  send_claim(status.device, device_claim_t::STAGE_HOLDING);
 }
 
 }  // namespace covtrack::server

@@ -22,7 +22,9 @@
 #include <functional>
 #include <map>
 #include <mutex>
+#include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -32,6 +34,8 @@
 #include <covtrack/device_claim_t.hpp>
 #include <covtrack/device_status_t.hpp>
 
+#include "claim_listener.hpp"
+#include "covtrack/protocol/result.hpp"
 #include "publisher_identity.hpp"
 
 namespace covtrack::server {
@@ -49,10 +53,13 @@ class DeviceOwnership {
   // Waits up to the given time; false when the daemon is told to stop meanwhile.
   using Wait = std::function<bool(std::chrono::milliseconds)>;
 
-  // Starts listening on `lcm` (which the daemon also publishes on) for the claims and
-  // heartbeats of `devices`.
-  DeviceOwnership(lcm::LCM& lcm, PublisherIdentity identity, const std::vector<std::string>& devices,
-                  ClaimSettings settings, GiveUp give_up);
+  // Publishes claims on `lcm` and starts listening for the claims and heartbeats of
+  // `devices`: on a udpm:// `url` through a ClaimListener, else (memq://) through `lcm`.
+  // Fails when the listener cannot join the group.
+  static Result<std::unique_ptr<DeviceOwnership>> open(lcm::LCM& lcm, const std::string& url,
+                                                       PublisherIdentity identity,
+                                                       const std::vector<std::string>& devices,
+                                                       ClaimSettings settings, GiveUp give_up);
   ~DeviceOwnership();
   DeviceOwnership(const DeviceOwnership&) = delete;
   DeviceOwnership& operator=(const DeviceOwnership&) = delete;
@@ -75,9 +82,13 @@ class DeviceOwnership {
     std::map<std::int64_t, Other> others;  // by instance id
   };
 
+  DeviceOwnership(lcm::LCM& lcm, PublisherIdentity identity, const std::vector<std::string>& devices,
+                  ClaimSettings settings, GiveUp give_up);
   void listen(std::stop_token stop);
-  void on_claim(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void on_status(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_message(const std::string& channel, std::span<const std::byte> bytes);
+  void on_lcm_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_claim(const device_claim_t& claim);
+  void on_status(const device_status_t& status);
   void send_claim(const std::string& device, std::int8_t stage);
   // Whether `other` comes before this daemon in the race rule.
   bool comes_first(std::int64_t instance_id, const Other& other) const;
@@ -93,7 +104,8 @@ class DeviceOwnership {
 
   std::mutex mutex_;  // guards devices_
   std::map<std::string, Device> devices_;
-  std::vector<lcm::Subscription*> subscriptions_;
+  std::unique_ptr<ClaimListener> listener_;    // udpm://
+  std::vector<lcm::Subscription*> subscriptions_;  // else
   std::jthread thread_;
 };
 

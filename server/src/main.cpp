@@ -115,13 +115,17 @@ int main(int argc, char** argv) {
   for (const auto& d : config->devices) names.push_back(d.name);
   const covtrack::server::ClaimSettings claim{config->daemon.claim_wait_s,
                                               config->daemon.allow_duplicate_publishers || allow_duplicates};
-  covtrack::server::DeviceOwnership ownership(**lcm, host.identity(), names, claim,
-                                              [&host](const std::string& device, const std::string& why) {
-                                                spdlog::error("covtrackd: device '{}' stopped: {}", device, why);
-                                                if (!host.give_up(device)) covtrack::server::signal_nothing_left();
-                                              });
+  auto ownership = covtrack::server::DeviceOwnership::open(
+      **lcm, url, host.identity(), names, claim, [&host](const std::string& device, const std::string& why) {
+        spdlog::error("covtrackd: device '{}' stopped: {}", device, why);
+        if (!host.give_up(device)) covtrack::server::signal_nothing_left();
+      });
+  if (!ownership) {
+    std::cerr << "covtrackd: " << ownership.error().message << "\n";
+    return kExitRuntimeError;
+  }
   std::optional<int> early_signal;
-  const auto refused = ownership.claim([&](std::chrono::milliseconds t) {
+  const auto refused = (*ownership)->claim([&](std::chrono::milliseconds t) {
     early_signal = covtrack::server::wait_for_stop_signal(stop_signals, t);
     return !early_signal;
   });

@@ -1,5 +1,6 @@
-// The race rule on its own: two claimants whose claim waits run side by side over real
-// UDP multicast (inside this test's network namespace), 2 s each, so that each hears the other
+// The race rule on its own: two claimants (publishing on one LCM instance, each listening
+// through its own filtered socket) whose claim waits run side by side over real UDP
+// multicast (inside this test's network namespace), 2 s each, so that each hears the other
 // only as a claimant, never as a holder. Exactly one keeps the device: the earlier claim.
 // And a holder answers a later claimant at once.
 #include <gtest/gtest.h>
@@ -33,15 +34,16 @@ DeviceOwnership::GiveUp no_give_up() {
 }  // namespace
 
 TEST(OwnershipRace, TwoClaimsAtOnceLeaveTheDeviceToTheEarlierClaim) {
-  lcm::LCM lcm_a(kUrl), lcm_b(kUrl);
-  ASSERT_TRUE(lcm_a.good() && lcm_b.good());
-  // Constructed one after the other: a's claimed_us is the smaller (or equal, then the ids
+  lcm::LCM lcm(kUrl);
+  ASSERT_TRUE(lcm.good());
+  // Opened one after the other: a's claimed_us is the smaller (or equal, then the ids
   // decide, and 1 < 2 as well).
-  DeviceOwnership a(lcm_a, identity(1, 101), {"rig", "other_a"}, {.wait_s = 2}, no_give_up());
-  DeviceOwnership b(lcm_b, identity(2, 202), {"rig", "other_b"}, {.wait_s = 2}, no_give_up());
+  auto a = DeviceOwnership::open(lcm, kUrl, identity(1, 101), {"rig", "other_a"}, {.wait_s = 2}, no_give_up());
+  auto b = DeviceOwnership::open(lcm, kUrl, identity(2, 202), {"rig", "other_b"}, {.wait_s = 2}, no_give_up());
+  ASSERT_TRUE(a && b);
 
-  auto claim_a = std::async(std::launch::async, [&] { return a.claim(wait_out); });
-  auto claim_b = std::async(std::launch::async, [&] { return b.claim(wait_out); });
+  auto claim_a = std::async(std::launch::async, [&] { return (*a)->claim(wait_out); });
+  auto claim_b = std::async(std::launch::async, [&] { return (*b)->claim(wait_out); });
   const auto refused_a = claim_a.get();
   const auto refused_b = claim_b.get();
   ASSERT_TRUE(refused_a && refused_b);
@@ -55,13 +57,15 @@ TEST(OwnershipRace, TwoClaimsAtOnceLeaveTheDeviceToTheEarlierClaim) {
 }
 
 TEST(OwnershipRace, AHolderAnswersALaterClaimantAtOnce) {
-  lcm::LCM lcm_a(kUrl), lcm_b(kUrl);
-  ASSERT_TRUE(lcm_a.good() && lcm_b.good());
-  DeviceOwnership a(lcm_a, identity(9, 909), {"rig"}, {.wait_s = 0}, no_give_up());
-  ASSERT_TRUE(a.claim(wait_out));  // no wait: holds at once, and sends no heartbeat here
+  lcm::LCM lcm(kUrl);
+  ASSERT_TRUE(lcm.good());
+  auto a = DeviceOwnership::open(lcm, kUrl, identity(9, 909), {"rig"}, {.wait_s = 0}, no_give_up());
+  ASSERT_TRUE(a);
+  ASSERT_TRUE((*a)->claim(wait_out));  // no wait: holds at once, and sends no heartbeat here
 
-  DeviceOwnership b(lcm_b, identity(3, 303), {"rig"}, {.wait_s = 0.5}, no_give_up());
-  const auto refused = b.claim(wait_out);
+  auto b = DeviceOwnership::open(lcm, kUrl, identity(3, 303), {"rig"}, {.wait_s = 0.5}, no_give_up());
+  ASSERT_TRUE(b);
+  const auto refused = (*b)->claim(wait_out);
   ASSERT_TRUE(refused);
   ASSERT_TRUE(refused->contains("rig"));
   // Refused for the holder, even though b's instance id is the smaller.

@@ -1,6 +1,8 @@
 #pragma once
 // Opening LCM without its silent failure modes: an unusable URL is reported at once,
 // with how to fix it, instead of a ~10 s self-test hang on the first subscribe.
+#include <netinet/in.h>
+
 #include <memory>
 #include <string>
 
@@ -16,6 +18,9 @@ std::string effective_lcm_url(const std::string& url);
 
 // Checks that the URL can work on this machine (for udpm: a route to the group).
 Result<void> check_lcm_url(const std::string& url);
+
+// The group and port of a udpm:// URL (LCM's defaults where it names none).
+Result<sockaddr_in> parse_udpm(const std::string& url);
 
 // check_lcm_url, then create the instance.
 Result<std::unique_ptr<lcm::LCM>> open_lcm(const std::string& url);
