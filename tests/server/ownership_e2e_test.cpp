@@ -9,12 +9,13 @@
 // - Without a claim wait both start; the later claim gives the device up when the two
 //   hear each other's heartbeats.
 // - --allow-duplicate-publishers: both publish, both daemons say so, and the client names
-//   both ("device rig published by two daemons: host/pid and host/pid").
+//   both ("device rig published by two daemons: host/pid and host/pid"), covtrack echo as well.
 #include <gtest/gtest.h>
 #include <poll.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <set>
@@ -251,6 +252,22 @@ TEST(Ownership, AllowedDuplicatesBothPublishAndEveryoneNamesBoth) {
   const std::string host = host_name();
   EXPECT_EQ(client::second_publisher_warning("rig", devices.at("rig")),
             fmt::format("device rig published by two daemons: {}/{} and {}/{}", host, first.pid(), host, second.pid()));
+
+  // covtrack echo says it too, on stderr (its --json output has no table).
+  const std::string echo = fmt::format("{}/tools/covtrack/covtrack echo -u '{}' --json --duration 1 2>&1 >/dev/null",
+                                       COVTRACK_BINARY_DIR, url);
+  std::string echoed;
+  if (FILE* out = ::popen(echo.c_str(), "r")) {
+    char buf[4096];
+    while (std::size_t n = std::fread(buf, 1, sizeof buf, out)) echoed.append(buf, n);
+    EXPECT_EQ(::pclose(out), 0) << echoed;
+  }
+  // In the order echo first heard them.
+  const auto said = [&](pid_t one, pid_t other) {
+    return echoed.find(fmt::format("covtrack echo: device rig published by two daemons: {}/{} and {}/{}", host, one,
+                                   host, other)) != std::string::npos;
+  };
+  EXPECT_TRUE(said(first.pid(), second.pid()) || said(second.pid(), first.pid())) << echoed;
 
   int status = 0;
   EXPECT_GE(second.process->stop(SIGTERM, status), 0);
