@@ -117,6 +117,9 @@ def test_poses_covariances_callbacks_and_devices(daemon, config):
         wait_until(lambda: {"optical", "magnetic"} <= set(s.devices()), "heartbeats")
         device = s.devices()["optical"]
         assert device.reachable and device.state == "RUNNING" and device.driver == "sim"
+        assert device.publishers == 1 and len(device.publishing) == 1
+        assert device.publishing[0] == f"{device.host}/{device.pid}"
+        assert device.second_publisher_warning == ""
     assert s.closed
     with pytest.raises(RuntimeError, match="closed"):
         s.latest("optical", "head")
