@@ -168,7 +168,9 @@ void DeviceOwnership::on_claim(const device_claim_t& claim) {
       send_claim(claim.device, device_claim_t::STAGE_HOLDING);  // the answer: we hold it
       return;
     }
-    if (!comes_first(claim.instance_id, other) || settings_.allow_duplicates) {
+    // Given up only to a daemon whose heartbeats were heard too: a claim alone (one
+    // datagram anyone can send) does not stop a device.
+    if (!comes_first(claim.instance_id, other) || !other.publishing || settings_.allow_duplicates) {
       name_once(claim.device, claim.instance_id, other);
       return;
     }
@@ -187,6 +189,7 @@ void DeviceOwnership::on_status(const device_status_t& status) {
   Device& device = devices_[status.device];
   Other& other = device.others[status.instance_id];
   other.holding = true;
+  other.publishing = true;
   other.host = status.host;
   other.pid = status.pid;
   // Two holders: ours goes out so that the later of the two learns it and gives up.

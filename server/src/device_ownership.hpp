@@ -73,6 +73,7 @@ class DeviceOwnership {
   struct Other {
     std::int64_t claimed_us = 0;  // 0 until a claim of it is heard
     bool holding = false;         // a heartbeat or a HOLDING claim heard
+    bool publishing = false;      // a heartbeat heard: it does publish the device
     bool named = false;           // said in the log already
     std::string host;
     std::int32_t pid = 0;
