@@ -4,7 +4,6 @@
 #include <cstdlib>
 #include <iostream>
 #include <set>
-#include <pthread.h>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
@@ -20,22 +19,11 @@
 namespace {
 using namespace covtrack::program;
 constexpr const char* kSignalNote =
-    "A stop signal before the devices start ends covtrackd at once, by that signal (status 130 or 143 in a "
-    "shell). Exit code 4 names the stuck device on the log; the daemon exits anyway. Exit code 1 also when "
-    "another daemon already publishes every configured device (the log names it).";
+    "A stop signal while the config is read ends covtrackd at once, by that signal (status 130 or 143 in a "
+    "shell); while it claims its devices (daemon.claim_wait_s), with code 0 and nothing started. Exit code 4 "
+    "names the stuck device on the log; the daemon exits anyway. Exit code 1 also when another daemon already "
+    "publishes every configured device (the log names it).";
 
-// The signal that came before the devices started ends the daemon by that signal.
-[[noreturn]] void end_by(int signal) {
-  std::cerr << "covtrackd: " << (signal == SIGINT ? "SIGINT" : "SIGTERM")
-            << " before the devices started; nothing was started\n";
-  std::signal(signal, SIG_DFL);
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, signal);
-  pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
-  std::raise(signal);
-  std::_Exit(kExitRuntimeError);  // not reached
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -129,7 +117,10 @@ int main(int argc, char** argv) {
     early_signal = covtrack::server::wait_for_stop_signal(stop_signals, t);
     return !early_signal;
   });
-  if (!refused) end_by(*early_signal);
+  if (!refused) {  // LCM and a VRPN server may be up: a normal stop, before any device
+    spdlog::info("covtrackd: {} while claiming the devices; none was started", *early_signal == SIGINT ? "SIGINT" : "SIGTERM");
+    return 0;
+  }
   std::set<std::string> not_started;
   for (const auto& [device, why] : *refused) {
     spdlog::error("covtrackd: device '{}' not started: {}", device, why);
