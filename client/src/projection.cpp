@@ -169,8 +169,13 @@ bool rotation_too_uncertain(const Mat6& C, double max_sigma_rad) {
 Mat2 repair_psd(const Mat2& C, bool& repaired) {
   const double tr = C.trace(), det = C.determinant();
   if (tr >= 0 && det >= 0) return C;
-  repaired = true;
   Eigen::SelfAdjointEigenSolver<Mat2> eig(C);
+  // A negative eigenvalue within rounding of the sums (a pose known exactly, or nearly:
+  // every sigma point on the same pixel) is clipped without a flag; only a real one,
+  // from the negative centre weight on a bending map, is reported.
+  constexpr double kRoundingPx2 = 1e-12, kRoundingRelative = 1e-9;
+  const double scale = eig.eigenvalues().cwiseAbs().maxCoeff();
+  repaired = repaired || eig.eigenvalues().minCoeff() < -std::max(kRoundingPx2, kRoundingRelative * scale);
   return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
          eig.eigenvectors().transpose();
 }

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "example_camera.hpp"
 
@@ -299,6 +300,44 @@ TEST(ProjectionFlags, SingularCovarianceIsFine) {
   const ProjectedVertex v = project_vertex(cam, {object_pose(), C, false}, Vec3(0.1, 0, 0));
   EXPECT_TRUE(v.flags.usable());
   EXPECT_GT(v.covariance_px2.trace(), 0);
+}
+
+// A pose known exactly: every sigma point is the same pixel, and the few ulps the
+// unscented sums leave are not a repaired (indefinite) covariance.
+TEST(ProjectionFlags, ZeroCovarianceIsNotRepaired) {
+  const Camera cam = test::example_camera();
+  ProjectionOptions exact;
+  exact.add_intrinsic_uncertainty = false;
+  int repaired = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 p(0.02 * (i % 10) - 0.1, 0.015 * (i / 10) - 0.15, 0.03 * (i % 7));
+    const ProjectedVertex v = project_vertex(cam, {object_pose(), Mat6::Zero(), false}, p, exact);
+    repaired += v.flags.covariance_repaired;
+    EXPECT_TRUE(v.flags.usable());
+    EXPECT_LT(v.covariance_px2.norm(), 1e-9) << i;
+  }
+  EXPECT_EQ(repaired, 0);
+}
+
+// The plain UT's negative centre weight (kappa = 3 - n) gives an indefinite matrix when
+// the map bends hard (here 0.12-0.76 rad of rotation sigma, a vertex 0.5 m off the origin,
+// found by a random search; eigenvalues -2745 and 75791 px^2): flagged, and clipped to PSD.
+TEST(ProjectionFlags, IndefiniteUnscentedCovarianceIsRepairedAndFlagged) {
+  const Camera cam = test::example_camera();
+  ProjectionOptions o;
+  o.add_intrinsic_uncertainty = false;
+  o.max_rotation_sigma_rad = 10.0;  // let the bend through
+  Vec6 sd;
+  sd << 0.030502, 0.017640, 0.026645, 0.120591, 0.763504, 0.580627;
+  const Mat6 C = sd.cwiseAbs2().asDiagonal();
+  const Pose T = pose_from(Vec3(-0.089660, 0.135000, 0.851147),
+                           Eigen::Quaterniond(0.981031, -0.037924, -0.112539, 0.153218).normalized());
+  const ProjectedVertex v = project_vertex(cam, {T, C, false}, Vec3(-0.220549, 0.178030, -0.489654), o);
+  ASSERT_TRUE(v.flags.usable());
+  EXPECT_TRUE(v.flags.covariance_repaired);
+  Eigen::SelfAdjointEigenSolver<Mat2> eig(v.covariance_px2);
+  EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-9 * eig.eigenvalues().maxCoeff());
+  EXPECT_GT(eig.eigenvalues().maxCoeff(), 1.0);  // a real spread of pixels, not rounding
 }
 
 // ---- calibration files ----

@@ -68,7 +68,9 @@ const TableSpec& keyframe_spec() {
        {"position_m", ValueType::FloatArray, "m", "the transform's",
         "child origin in the parent frame at t_s", -1e6, 1e6, 3},
        {"sigma_scale", ValueType::Float, "", "1",
-        "multiplies the transform's sigmas at t_s (its covariance by the square)", 0, 1e4}}};
+        "multiplies the transform's sigmas at t_s (its covariance by the square)", 0, 1e4},
+       {"lost", ValueType::Boolean, "", "false",
+        "the tracker reports LOST from t_s until the next keyframe (its last pose, infinitely uncertain)"}}};
   return s;
 }
 
@@ -127,7 +129,8 @@ void read_keyframes(TableReader& r, SceneTransform& t) {
     r.error("keyframe", "keyframes script a tracker's reports: the transform needs a stream");
   for (std::size_t i = 0; i < tables.size(); ++i) {
     TableReader k(*tables[i], r.path(fmt::format("keyframe[{}]", i)), keyframe_spec(), r.file(), r.errors());
-    Keyframe f{k.number("t_s"), k.vec3("position_m", t.T_parent_child.translation()), k.number("sigma_scale", 1)};
+    Keyframe f{k.number("t_s"), k.vec3("position_m", t.T_parent_child.translation()), k.number("sigma_scale", 1),
+               k.boolean("lost", false)};
     if (i == 0 && f.t_s != 0) k.error("t_s", "the first keyframe is at 0");
     if (i > 0 && f.t_s <= t.keyframes.back().t_s) k.error("t_s", "keyframes must be in ascending time");
     t.keyframes.push_back(f);
