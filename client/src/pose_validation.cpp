@@ -42,13 +42,8 @@ TrackedTransform to_tracked_transform(const pose_cov_t& msg, std::int64_t receiv
   const bool usable_pose =
       !t.lost() || (finite_position(msg) && quaternion_norm_error(msg) <= kQuaternionNormTolerance);
   if (usable_pose) t.T_parent_child = pose_of(msg);
-  if (t.lost()) {
-    // Infinite uncertainty; Identity() * INFINITY would put NaN (0 * inf) off the diagonal.
-    t.covariance = Mat6::Zero();
-    t.covariance.diagonal().setConstant(INFINITY);
-  } else {
-    t.covariance = body_covariance_of(msg);
-  }
+  // Infinite uncertainty, whatever the sender put in a LOST message's matrix.
+  t.covariance = t.lost() ? lost_covariance() : body_covariance_of(msg);
   t.measurement_time_us = msg.measurement_time_us;
   t.publish_time_us = msg.publish_time_us;
   t.receive_time_us = receive_time_us;

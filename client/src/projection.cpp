@@ -169,8 +169,13 @@ bool rotation_too_uncertain(const Mat6& C, double max_sigma_rad) {
 Mat2 repair_psd(const Mat2& C, bool& repaired) {
   const double tr = C.trace(), det = C.determinant();
   if (tr >= 0 && det >= 0) return C;
-  repaired = true;
   Eigen::SelfAdjointEigenSolver<Mat2> eig(C);
+  // A negative eigenvalue within rounding of the sums (a pose known exactly, or nearly:
+  // every sigma point on the same pixel) is clipped without a flag; only a real one,
+  // from the negative centre weight on a bending map, is reported.
+  constexpr double kRoundingPx2 = 1e-12, kRoundingRelative = 1e-9;
+  const double scale = eig.eigenvalues().cwiseAbs().maxCoeff();
+  repaired = repaired || eig.eigenvalues().minCoeff() < -std::max(kRoundingPx2, kRoundingRelative * scale);
   return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
          eig.eigenvectors().transpose();
 }
@@ -184,6 +189,7 @@ struct UnscentedBlock {
   double u0[kBlock], v0[kBlock];  // pixel of the unperturbed vertex (sigma point 0)
   double z0[kBlock];              // its camera depth
   double zmin[kBlock];            // the nearest depth over all sigma points
+  double r2max[kBlock];           // the largest normalised radius^2 over all sigma points
   double mean_u[kBlock], mean_v[kBlock];
   double cuu[kBlock], cuv[kBlock], cvv[kBlock];
 };
@@ -194,10 +200,11 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
   // Local copies: the compiler need not fear that a store through `out` changes them.
   const Camera cam = camera;
   const double wm0 = s.wm0, wc0 = s.wc0, wi = s.wi;
-  double u[kSigmaPoints][kBlock], v[kSigmaPoints][kBlock], zmin[kBlock], z0[kBlock];
+  double u[kSigmaPoints][kBlock], v[kSigmaPoints][kBlock], zmin[kBlock], z0[kBlock], r2max[kBlock];
   for (int j = 0; j < kBlock; ++j) {
     const auto& m = s.pose;
     z0[j] = zmin[j] = m[6][0] * px[j] + m[7][0] * py[j] + m[8][0] * pz[j] + m[11][0];
+    r2max[j] = 0;
   }
   for (int i = 0; i < kSigmaPoints; ++i) {
     double m[12];  // pose i
@@ -207,9 +214,10 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
       const double y = m[3] * px[j] + m[4] * py[j] + m[5] * pz[j] + m[10];
       const double z = m[6] * px[j] + m[7] * py[j] + m[8] * pz[j] + m[11];
       // A point behind the camera gives a meaningless pixel here; the caller checks zmin.
-      const double iz = 1 / z;
-      cam.pixel_of_normalised(x * iz, y * iz, u[i][j], v[i][j]);
+      const double iz = 1 / z, xn = x * iz, yn = y * iz;
+      cam.pixel_of_normalised(xn, yn, u[i][j], v[i][j]);
       zmin[j] = std::min(zmin[j], z);
+      r2max[j] = std::max(r2max[j], xn * xn + yn * yn);
     }
   }
   double mu[kBlock], mv[kBlock], cuu[kBlock], cuv[kBlock], cvv[kBlock];
@@ -226,7 +234,7 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
       cuu[j] += wi * du * du, cuv[j] += wi * du * dv, cvv[j] += wi * dv * dv;
     }
   for (int j = 0; j < kBlock; ++j) {
-    out.u0[j] = u[0][j], out.v0[j] = v[0][j], out.z0[j] = z0[j], out.zmin[j] = zmin[j];
+    out.u0[j] = u[0][j], out.v0[j] = v[0][j], out.z0[j] = z0[j], out.zmin[j] = zmin[j], out.r2max[j] = r2max[j];
     out.mean_u[j] = mu[j], out.mean_v[j] = mv[j];
     out.cuu[j] = cuu[j], out.cuv[j] = cuv[j], out.cvv[j] = cvv[j];
   }
@@ -235,7 +243,7 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
 // The first-order path in the same blocks: per vertex J = J_camera R [I, -skew(p)]
 // (pixel_jacobian_wrt_perturbation) and J C J^T, written out over the block's lanes.
 struct LinearBlock {
-  double u[kBlock], v[kBlock], z[kBlock];
+  double u[kBlock], v[kBlock], z[kBlock], r2[kBlock];
   double cuu[kBlock], cuv[kBlock], cvv[kBlock];
 };
 
@@ -281,7 +289,7 @@ void linear_block(const Camera& camera, const Pose& T, const Mat6& covariance,
     double uu = 0, uv = 0, vv = 0;
 #pragma GCC unroll 6
     for (int a = 0; a < 6; ++a) uu += J[0][a] * CJ0[a], uv += J[0][a] * CJ1[a], vv += J[1][a] * CJ1[a];
-    out.u[j] = u, out.v[j] = v, out.z[j] = z;
+    out.u[j] = u, out.v[j] = v, out.z[j] = z, out.r2[j] = xn * xn + yn * yn;
     out.cuu[j] = uu, out.cuv[j] = uv, out.cvv[j] = vv;
   }
 }
@@ -312,6 +320,7 @@ void project_linear(const Camera& camera, const UncertainPose& pose,
                     std::span<const Vec3> points, const ProjectionOptions& o,
                     const ProjectionFlags& shared, std::vector<ProjectedVertex>& out) {
   const bool add_intrinsic = o.add_intrinsic_uncertainty && !camera.intrinsic_sigmas_px.isZero();
+  const double fold_r2 = camera.distortion_fold_r2();
   LinearBlock b;
   for (std::size_t first = 0; first < points.size(); first += kBlock) {
     double px[kBlock], py[kBlock], pz[kBlock];
@@ -321,6 +330,7 @@ void project_linear(const Camera& camera, const UncertainPose& pose,
       ProjectedVertex& v = start_vertex(out, b.z[j], shared, o);
       if (v.flags.behind_camera) continue;
       v.mean_px = Vec2(b.u[j], b.v[j]);
+      if ((v.flags.past_distortion_fold = b.r2[j] >= fold_r2)) continue;
       v.covariance_px2 << b.cuu[j], b.cuv[j], b.cuv[j], b.cvv[j];
       if (add_intrinsic) v.covariance_px2 += camera.intrinsic_covariance_at(v.mean_px);
     }
@@ -332,6 +342,7 @@ void project_unscented(const Camera& camera, const UncertainPose& pose,
                        const ProjectionFlags& shared, std::vector<ProjectedVertex>& out) {
   const SigmaPoses sigma = make_sigma_poses(pose, o.unscented);
   const bool add_intrinsic = o.add_intrinsic_uncertainty && !camera.intrinsic_sigmas_px.isZero();
+  const double fold_r2 = camera.distortion_fold_r2();
   UnscentedBlock b;
   for (std::size_t first = 0; first < points.size(); first += kBlock) {
     double px[kBlock], py[kBlock], pz[kBlock];
@@ -346,6 +357,7 @@ void project_unscented(const Camera& camera, const UncertainPose& pose,
         v.flags.sigma_point_behind_camera = true;
         continue;
       }
+      if ((v.flags.past_distortion_fold = b.r2max[j] >= fold_r2)) continue;  // no covariance either
       const Vec2 unperturbed = v.mean_px;
       v.mean_px = Vec2(b.mean_u[j], b.mean_v[j]);
       Mat2 C;
@@ -374,10 +386,13 @@ void project_vertices(const Camera& camera, const UncertainPose& pose,
                : project_linear(camera, pose, points, o, shared, out);
 
   // LOST: the pixel of the last estimate, no covariance.
+  const double fold_r2 = camera.distortion_fold_r2();
   for (const Vec3& p : points) {
     const Vec3 pc = pose.T * p;
     ProjectedVertex& v = start_vertex(out, pc.z(), shared, o);
-    if (!v.flags.behind_camera) v.mean_px = camera.project(pc);
+    if (v.flags.behind_camera) continue;
+    v.mean_px = camera.project(pc);
+    v.flags.past_distortion_fold = pc.head<2>().squaredNorm() >= fold_r2 * pc.z() * pc.z();
   }
 }
 

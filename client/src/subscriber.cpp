@@ -182,8 +182,7 @@ struct Subscriber::Impl {
   // The last report of a stream whose device is unreachable, made LOST.
   static TrackedTransform unreachable(TrackedTransform last, std::int64_t now) {
     last.status = TrackingStatus::Lost;
-    last.covariance = Mat6::Zero();
-    last.covariance.diagonal().setConstant(INFINITY);  // as a LOST message arrives (TrackedTransform)
+    last.covariance = lost_covariance();  // as a LOST message arrives (TrackedTransform)
     last.receive_time_us = now;
     last.device_unreachable = true;
     return last;

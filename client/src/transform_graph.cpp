@@ -4,7 +4,7 @@
 #include <unordered_set>
 
 #include "covtrack/client/graph_chain.hpp"
-#include "covtrack/client/graph_seed_matrix16.hpp"
+#include "covtrack/client/graph_osgar_matrix16.hpp"
 
 namespace covtrack::client {
 
@@ -228,7 +228,7 @@ Result<QueryResult> TransformGraph::query_detailed(const std::string& A, const s
       out.pose.covariance = p.covariance;
       break;
     }
-    case Propagation::SeedRoot: {
+    case Propagation::OsgarRoot: {
       const UncertainPose root_A = compose_chain(root_chain(path_A));
       const UncertainPose root_B = compose_chain(root_chain(path_B));
       const std::vector<ChainFactor> f{{root_A.T, root_A.covariance, true},
@@ -238,13 +238,13 @@ Result<QueryResult> TransformGraph::query_detailed(const std::string& A, const s
       out.pose.covariance = p.covariance;
       break;
     }
-    case Propagation::SeedMatrix16: {
+    case Propagation::OsgarMatrix16: {
       auto estimate = [](const std::vector<ChainFactor>& chain) {
         MatrixEstimate e;
-        for (const auto& f : chain) e = seed_propagate(e, f.T, f.covariance);
+        for (const auto& f : chain) e = osgar_propagate(e, f.T, f.covariance);
         return e;
       };
-      const UncertainPose p = seed_relative(estimate(root_chain(path_A)), estimate(root_chain(path_B)));
+      const UncertainPose p = osgar_relative(estimate(root_chain(path_A)), estimate(root_chain(path_B)));
       out.pose.T = p.T;
       out.pose.covariance = p.covariance;
       break;

@@ -1,6 +1,7 @@
 #include "covtrack/protocol/pose_message.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace covtrack {
 
@@ -11,6 +12,12 @@ const char* to_string(TrackingStatus status) {
     case TrackingStatus::Lost: return "LOST";
   }
   return "?";
+}
+
+Mat6 lost_covariance() {
+  Mat6 cov = Mat6::Zero();
+  cov.diagonal().setConstant(std::numeric_limits<double>::infinity());
+  return cov;
 }
 
 namespace {

@@ -134,11 +134,11 @@ TEST(FullChain, WorldObjectScreenCovarianceMatchesMonteCarlo) {
     const Chain chain(c.head_rotation_deg * kDeg);
     const Mat2 mc = monte_carlo_covariance(chain, cam, true, kCorner);
     const double ours = relative_frobenius(predicted(chain, cam, "table", kCorner), mc);
-    const double seed = relative_frobenius(
-        predicted(chain, cam, "table", kCorner, Propagation::SeedMatrix16), mc);
+    const double osgar = relative_frobenius(
+        predicted(chain, cam, "table", kCorner, Propagation::OsgarMatrix16), mc);
     std::printf("head rotation sigma %4.1f deg: MC sigma (%.1f, %.1f) px; relative Frobenius "
                 "error: LCA + UT %.4f, additive matrix model %.4f\n",
-                c.head_rotation_deg, std::sqrt(mc(0, 0)), std::sqrt(mc(1, 1)), ours, seed);
+                c.head_rotation_deg, std::sqrt(mc(0, 0)), std::sqrt(mc(1, 1)), ours, osgar);
     // No edge is shared here (the world is the common ancestor), so the dissertation's
     // model, converted to BODY before the same UT, agrees to first order: printed, not
     // asserted.
@@ -155,11 +155,11 @@ TEST(FullChain, HeadAttachedObjectIgnoresTheHeadTracker) {
 
   const Mat2 shaky_mc = monte_carlo_covariance(shaky, cam, false, kCorner);
   const double err = relative_frobenius(shaky_prediction, shaky_mc);
-  const double seed = relative_frobenius(
-      predicted(shaky, cam, "visor", kCorner, Propagation::SeedMatrix16), shaky_mc);
+  const double osgar = relative_frobenius(
+      predicted(shaky, cam, "visor", kCorner, Propagation::OsgarMatrix16), shaky_mc);
   std::printf("head-attached object, head rotation sigma 10 deg: MC sigma (%.2f, %.2f) px; "
               "relative Frobenius error LCA + UT %.4f, additive matrix model %.1f\n",
-              std::sqrt(shaky_mc(0, 0)), std::sqrt(shaky_mc(1, 1)), err, seed);
+              std::sqrt(shaky_mc(0, 0)), std::sqrt(shaky_mc(1, 1)), err, osgar);
   EXPECT_LT(err, 0.01);
-  EXPECT_GT(seed, 1.0) << "the root-based additive matrix model should inflate it by far";
+  EXPECT_GT(osgar, 1.0) << "the root-based additive matrix model should inflate it by far";
 }

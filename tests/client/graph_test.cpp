@@ -14,7 +14,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "covtrack/client/combiner.hpp"
-#include "covtrack/client/graph_seed_matrix16.hpp"
+#include "covtrack/client/graph_osgar_matrix16.hpp"
 #include "covtrack/client/transform_graph.hpp"
 
 using namespace covtrack;
@@ -161,38 +161,38 @@ TEST(TransformGraph, HeadAttachedObjectMatchesMonteCarloAndIgnoresSharedEdges) {
   EXPECT_TRUE(w.graph.query("camera", "object", kT0 + 2)->unbounded);
 }
 
-TEST(TransformGraph, SeedModelsAgreeWithExactWithoutSharedEdges) {
+TEST(TransformGraph, OsgarModelsAgreeWithExactWithoutSharedEdges) {
   // With the LCA at the root, root-based propagation is right: the dissertation's
   // 16-element model, converted to BODY, must then equal the exact first-order result (a
   // check of the 16-element implementation and of its conversion).
   HeadWorld w;
   auto exact = w.graph.query("camera", "object", kT0, Propagation::LowestCommonAncestor);
-  auto seed16 = w.graph.query("camera", "object", kT0, Propagation::SeedMatrix16);
-  auto root = w.graph.query("camera", "object", kT0, Propagation::SeedRoot);
-  ASSERT_TRUE(exact && seed16 && root);
-  EXPECT_LT(relative_frobenius(seed16->covariance, exact->covariance), 1e-9);
+  auto osgar16 = w.graph.query("camera", "object", kT0, Propagation::OsgarMatrix16);
+  auto root = w.graph.query("camera", "object", kT0, Propagation::OsgarRoot);
+  ASSERT_TRUE(exact && osgar16 && root);
+  EXPECT_LT(relative_frobenius(osgar16->covariance, exact->covariance), 1e-9);
   EXPECT_LT(relative_frobenius(root->covariance, exact->covariance), 1e-9);
-  EXPECT_TRUE(seed16->T.isApprox(exact->T, 1e-12));
+  EXPECT_TRUE(osgar16->T.isApprox(exact->T, 1e-12));
 }
 
-TEST(TransformGraph, SeedModelsOverestimateHeadAttachedObject) {
+TEST(TransformGraph, OsgarModelsOverestimateHeadAttachedObject) {
   HeadWorld w;
   auto exact = w.graph.query("camera", "held_object", kT0, Propagation::LowestCommonAncestor);
-  auto seed16 = w.graph.query("camera", "held_object", kT0, Propagation::SeedMatrix16);
-  auto root = w.graph.query("camera", "held_object", kT0, Propagation::SeedRoot);
-  ASSERT_TRUE(exact && seed16 && root);
+  auto osgar16 = w.graph.query("camera", "held_object", kT0, Propagation::OsgarMatrix16);
+  auto root = w.graph.query("camera", "held_object", kT0, Propagation::OsgarRoot);
+  ASSERT_TRUE(exact && osgar16 && root);
   auto position_sigma = [](const Mat6& c) { return std::sqrt(c.topLeftCorner<3, 3>().trace()); };
-  const double ratio16 = position_sigma(seed16->covariance) / position_sigma(exact->covariance);
+  const double ratio16 = position_sigma(osgar16->covariance) / position_sigma(exact->covariance);
   const double ratio_root = position_sigma(root->covariance) / position_sigma(exact->covariance);
   std::printf("held object position sigma: exact %.2f mm, 16-element root model %.2f mm (x%.1f), "
               "root-based %.2f mm (x%.1f)\n",
-              1e3 * position_sigma(exact->covariance), 1e3 * position_sigma(seed16->covariance),
+              1e3 * position_sigma(exact->covariance), 1e3 * position_sigma(osgar16->covariance),
               ratio16, 1e3 * position_sigma(root->covariance), ratio_root);
   EXPECT_GT(ratio16, 3.0);
   EXPECT_NEAR(ratio16, ratio_root, 1e-6 * ratio_root);  // both are the same first-order flaw
 }
 
-TEST(GraphSeedMatrix16, RoundTripsBodyCovariance) {
+TEST(GraphOsgarMatrix16, RoundTripsBodyCovariance) {
   const Pose T = pose(1, 2, 3, 0.3, -0.4, 0.5);
   const Mat6 C = covariance(0.01, 0.02, 9);
   EXPECT_LT(relative_frobenius(body_from_matrix16(T, matrix16_from_body(T, C)), C), 1e-12);

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "example_camera.hpp"
 
@@ -238,7 +239,9 @@ TEST(Projection, BlocksGiveWhatEachVertexGetsAlone) {
   const std::vector<ProjectedVertex> first_order = project_vertices(cam, coupled, points, linear);
   for (std::size_t k = 0; k < points.size(); ++k) {
     EXPECT_EQ(first_order[k].flags.behind_camera, k == 9) << "vertex " << k;
-    if (k == 9) continue;
+    // 1.5 cm deep and 5 cm aside: 73 degrees off-axis, past the lens model's fold.
+    EXPECT_EQ(first_order[k].flags.past_distortion_fold, k == 17) << "vertex " << k;
+    if (k == 9 || k == 17) continue;
     const Mat26 J = pixel_jacobian_wrt_perturbation(cam, coupled.T, points[k]);
     const Mat2 expected = J * coupled.covariance * J.transpose();
     EXPECT_LT(relative_frobenius(first_order[k].covariance_px2, expected), 1e-12) << "vertex " << k;
@@ -299,6 +302,88 @@ TEST(ProjectionFlags, SingularCovarianceIsFine) {
   const ProjectedVertex v = project_vertex(cam, {object_pose(), C, false}, Vec3(0.1, 0, 0));
   EXPECT_TRUE(v.flags.usable());
   EXPECT_GT(v.covariance_px2.trace(), 0);
+}
+
+// A pose known exactly: every sigma point is the same pixel, and the few ulps the
+// unscented sums leave are not a repaired (indefinite) covariance.
+TEST(ProjectionFlags, ZeroCovarianceIsNotRepaired) {
+  const Camera cam = test::example_camera();
+  ProjectionOptions exact;
+  exact.add_intrinsic_uncertainty = false;
+  int repaired = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 p(0.02 * (i % 10) - 0.1, 0.015 * (i / 10) - 0.15, 0.03 * (i % 7));
+    const ProjectedVertex v = project_vertex(cam, {object_pose(), Mat6::Zero(), false}, p, exact);
+    repaired += v.flags.covariance_repaired;
+    EXPECT_TRUE(v.flags.usable());
+    EXPECT_LT(v.covariance_px2.norm(), 1e-9) << i;
+  }
+  EXPECT_EQ(repaired, 0);
+}
+
+// The plain UT's negative centre weight (kappa = 3 - n) gave indefinite matrices (here
+// eigenvalues -2745 and 75791 px^2, 0.12-0.76 rad of rotation sigma, found by a random
+// search of 20,000 poses), but every such case had sigma points past the distortion fold,
+// where the lens model bends back; none was found inside it, with a pinhole camera, or
+// with alpha 0.5 or 0.1. Such a vertex is now flagged past the fold, without a covariance.
+TEST(ProjectionFlags, IndefiniteCasesLieBeyondTheDistortionFold) {
+  const Camera cam = test::example_camera();
+  ProjectionOptions o;
+  o.add_intrinsic_uncertainty = false;
+  o.max_rotation_sigma_rad = 10.0;  // let the bend through
+  Vec6 sd;
+  sd << 0.030502, 0.017640, 0.026645, 0.120591, 0.763504, 0.580627;
+  const Mat6 C = sd.cwiseAbs2().asDiagonal();
+  const Pose T = pose_from(Vec3(-0.089660, 0.135000, 0.851147),
+                           Eigen::Quaterniond(0.981031, -0.037924, -0.112539, 0.153218).normalized());
+  const ProjectedVertex v = project_vertex(cam, {T, C, false}, Vec3(-0.220549, 0.178030, -0.489654), o);
+  EXPECT_TRUE(v.flags.past_distortion_fold);
+  EXPECT_FALSE(v.flags.usable());
+  EXPECT_FALSE(v.flags.covariance_repaired);
+}
+
+// The example calibration's distortion stops growing 44 degrees off-axis;
+// past that a point would land back inside the image, at a wrong pixel.
+TEST(Camera, DistortionFoldIsWhereTheDistortedRadiusStopsGrowing) {
+  const Camera cam = test::example_camera();
+  const double fold = std::sqrt(cam.distortion_fold_r2());
+  std::printf("example camera: distortion fold at r = %.4f (%.1f degrees off-axis)\n", fold, std::atan(fold) / kDeg);
+  const auto distorted = [&](double r) { return r * (1 + r * r * (cam.k1 + r * r * (cam.k2 + r * r * cam.k3))); };
+  EXPECT_GT(distorted(fold * 0.999), distorted(fold * 0.99));
+  EXPECT_LT(distorted(fold * 1.01), distorted(fold * 1.001));
+  EXPECT_NEAR(std::atan(fold) / kDeg, 44, 2);
+  // 52 degrees off-axis is past the fold, yet its pixel lands back inside the image.
+  const Vec2 back = cam.project(Vec3(std::tan(52 * kDeg), 0, 1));
+  EXPECT_TRUE(back.x() >= 0 && back.x() < cam.width_px) << back.transpose();
+  Camera pinhole = cam;
+  pinhole.k1 = pinhole.k2 = pinhole.k3 = 0;
+  EXPECT_TRUE(std::isinf(pinhole.distortion_fold_r2()));
+}
+
+TEST(ProjectionFlags, PastTheDistortionFold) {
+  const Camera cam = test::example_camera();
+  const double fold_deg = std::atan(std::sqrt(cam.distortion_fold_r2())) / kDeg;
+  const auto ahead = [](double off_axis_deg) {  // a point 1 m away, this far off-axis
+    return Vec3(std::sin(off_axis_deg * kDeg), 0, std::cos(off_axis_deg * kDeg));
+  };
+  const UncertainPose camera_frame{Pose::Identity(), covariance(0.001, 0.5 * kDeg), false};
+  for (ProjectionMethod method : {ProjectionMethod::unscented, ProjectionMethod::linear}) {
+    ProjectionOptions o;
+    o.method = method;
+    const ProjectedVertex inside = project_vertex(cam, camera_frame, ahead(fold_deg - 10), o);
+    EXPECT_FALSE(inside.flags.past_distortion_fold);
+    EXPECT_TRUE(inside.flags.usable());
+    const ProjectedVertex past = project_vertex(cam, camera_frame, ahead(fold_deg + 5), o);
+    EXPECT_TRUE(past.flags.past_distortion_fold);
+    EXPECT_FALSE(past.flags.usable());
+  }
+  // Just inside, with 5 degrees of rotation sigma: sigma points cross the fold.
+  const ProjectedVertex straddling =
+      project_vertex(cam, {Pose::Identity(), covariance(0.001, 5 * kDeg), false}, ahead(fold_deg - 1));
+  EXPECT_TRUE(straddling.flags.past_distortion_fold);
+  // A LOST pose's last pixel is flagged the same way.
+  const ProjectedVertex lost = project_vertex(cam, {Pose::Identity(), Mat6::Zero(), true}, ahead(fold_deg + 5));
+  EXPECT_TRUE(lost.flags.past_distortion_fold);
 }
 
 // ---- calibration files ----

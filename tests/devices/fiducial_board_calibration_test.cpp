@@ -7,7 +7,8 @@
 //    rasteriser). The fitted bias equals the one measured against the true poses of the
 //    same frames, and the fitted model is judged on other frames of the same camera that
 //    differ in how they were made (the analytic rasteriser, another seed, the other
-//    polarity: single tags of tagStandard41h12): single-tag NEES near 6.
+//    polarity: single tags of tagStandard41h12): single-tag NEES within 2x of 6 in each
+//    condition and within chi-square(6)'s 99% bounds pooled.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -266,6 +267,8 @@ TEST(BoardCalibration, FitsARenderedCameraAsItsTruthShowsAndHoldsOnOtherFrames) 
   ASSERT_TRUE(board_detector && other_polarity);
   const TagBundle b = board(0.045);
   double fitted_bias[2] = {0, 0};
+  double pooled_sum = 0;
+  int pooled_count = 0;
   for (int g = 0; g < 2; ++g) {
     const double gamma = g == 0 ? 1.0 : 2.2;
     const RenderedBoard set =
@@ -293,15 +296,23 @@ TEST(BoardCalibration, FitsARenderedCameraAsItsTruthShowsAndHoldsOnOtherFrames) 
                   "tags\n",
                   detector->family().name().c_str(), with_defaults.mean, 100 * with_defaults.above_99, with_fit.mean,
                   100 * with_fit.above_99, with_fit.count);
-      // Never over-confident on other frames. Not asserted: the lower bound. At gamma 2.2
-      // the fit is over-conservative there (NEES 0.7-0.8 against 3.3-3.7 with the
-      // defaults): the board's small tags disagree more than the model's terms explain and
-      // the independent factor takes it (devices/fiducial/README.md, "Per-camera calibration").
+      // Honest both ways in every condition (within 2x of 6), and pooled below.
       EXPECT_GE(with_fit.count, 48);
+      EXPECT_GT(with_fit.mean, 3);
       EXPECT_LT(with_fit.mean, 12);
-      EXPECT_LE(with_fit.above_99, 0.05);
+      // The tail: the board's family as the board showed it; the other polarity's own
+      // code-dependent edge turns (up to 0.2 px) are what a tag36h11 board cannot show (10%
+      // above at gamma 1; devices/fiducial/README.md, "Per-camera calibration").
+      EXPECT_LE(with_fit.above_99, detector == board_detector.get() ? 0.05 : 0.12);
+      pooled_sum += with_fit.mean * with_fit.count, pooled_count += with_fit.count;
     }
   }
+  // Pooled over both cameras, families: chi-square(6)'s 99% bounds for the mean of this many.
+  const double pooled = pooled_sum / pooled_count, half_width = 2.576 * std::sqrt(12.0 / pooled_count);
+  std::printf("held out, pooled: NEES %.2f over %d tags (99%% bounds [%.2f, %.2f])\n", pooled, pooled_count,
+              6 - half_width, 6 + half_width);
+  EXPECT_GT(pooled, 6 - half_width);
+  EXPECT_LT(pooled, 6 + half_width);
   // The tone curve's bias is what the fit tracks: 0.36-0.45 px per px of blur at gamma 2.2.
   EXPECT_LT(fitted_bias[1], fitted_bias[0] - 0.2);
 }

@@ -1,11 +1,16 @@
 // A scene whose frames form one long chain, f0 -> f1 -> ... -> fN, loaded the whole way
 // (TOML text parsed, every transform added to a TransformGraph), the load's parts
-// alone, and a query end to end (T_f0_fN and its covariance through all N links).
+// alone, the same chain loaded from a transform table (a CSV file the scene names), and
+// a query end to end (T_f0_fN and its covariance through all N links).
 // Linear cost means the same time per link at every length: after the usual table, each
 // run's time per link is printed as a ratio to the 1,000-link run of the same benchmark
 // (the machine's speed cancels).
 // Run: taskset -c 0 build/tests/tools/bench_scene_chain
+#include <unistd.h>
+
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 
@@ -15,6 +20,7 @@
 
 #include "covtrack/scene/scene.hpp"
 #include "covtrack/scene/scene_graph.hpp"
+#include "covtrack/scene/transform_table.hpp"
 
 using namespace covtrack;
 
@@ -34,8 +40,19 @@ std::string chain_scene(int links) {
   return text;
 }
 
-scene::Scene parse(const std::string& text) {
-  auto scene = scene::parse_scene(text, "chain.toml", ".");
+// The same links as rows of a transform table, written to a real file that a scene names.
+std::string chain_table_scene(int links, const std::filesystem::path& dir) {
+  std::string rows{scene::kTransformTableHeader};
+  rows += '\n';
+  for (int i = 0; i < links; ++i)
+    fmt::format_to(std::back_inserter(rows), "f{},f{},0.01,0,0,0,0,0.1,1e-4,1e-4,1e-4,1e-4,1e-4,1e-4\n", i, i + 1);
+  const std::string name = fmt::format("chain_{}.csv", links);
+  std::ofstream(dir / name, std::ios::binary) << rows;
+  return fmt::format("transform_tables = [\"{}\"]\n[camera]\nframe = \"f0\"\ncalibration = \"camera.yml\"\n", name);
+}
+
+scene::Scene parse(const std::string& text, const std::string& base_dir = ".") {
+  auto scene = scene::parse_scene(text, "chain.toml", base_dir);
   if (!scene) throw std::runtime_error(scene.error().message);
   return std::move(*scene);
 }
@@ -54,6 +71,21 @@ void BM_LoadChain(benchmark::State& state) {
     add(parse(text), graph);
     benchmark::DoNotOptimize(&graph);
   }
+  state.counters["links"] = links;
+}
+
+// The whole load from a transform table: the scene, the file read and parsed, the graph.
+void BM_LoadChainTable(benchmark::State& state) {
+  const int links = static_cast<int>(state.range(0));
+  const auto dir = std::filesystem::temp_directory_path() / fmt::format("bench_scene_chain_{}", getpid());
+  std::filesystem::create_directories(dir);
+  const std::string text = chain_table_scene(links, dir);
+  for (auto _ : state) {
+    client::TransformGraph graph;
+    add(parse(text, dir.string()), graph);
+    benchmark::DoNotOptimize(&graph);
+  }
+  std::filesystem::remove_all(dir);
   state.counters["links"] = links;
 }
 
@@ -105,6 +137,7 @@ void BM_QueryChain(benchmark::State& state) {
 
 #define CHAIN_LENGTHS ->Arg(1'000)->Arg(10'000)->Arg(100'000)->Unit(benchmark::kMillisecond)
 BENCHMARK(BM_LoadChain) CHAIN_LENGTHS;
+BENCHMARK(BM_LoadChainTable) CHAIN_LENGTHS;
 BENCHMARK(BM_GraphChain) CHAIN_LENGTHS;
 BENCHMARK(BM_ParseChain) CHAIN_LENGTHS;
 BENCHMARK(BM_TomlChain) CHAIN_LENGTHS;

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "covtrack/lcmlog/log_reader.hpp"
 #include "covtrack/lcmlog/log_writer.hpp"
 #include "covtrack/lcmlog/recorder.hpp"
 #include "covtrack/lcmlog/replayer.hpp"
@@ -202,10 +203,31 @@ TEST(RecorderTest, RecordsEverythingPublishedUntilStopped) {
     if (m.channel.starts_with("covtrack/pose/")) poses.push_back(m);
   EXPECT_EQ(covtrack::testing::read_log(path), poses);
   EXPECT_EQ(summary->events, poses.size());
+  auto log = LogReader::open(path.string());
+  ASSERT_TRUE(log) << log.error().message;
+  std::int64_t previous = 0;
+  while (auto event = log->next()) {
+    EXPECT_GE(event->timestamp_us, previous) << "event " << event->event_number;
+    previous = event->timestamp_us;
+  }
   EXPECT_EQ(summary->events_per_channel.size(), 3u);
   EXPECT_EQ(summary->events_per_channel.at("covtrack/pose/sim/head"), 500u);
   EXPECT_EQ(summary->bytes, std::filesystem::file_size(path));
   std::filesystem::remove_all(dir);
+}
+
+// Receive stamps out of order, as the kernel gives a session's first datagrams: each
+// event keeps its place, none is stamped before the one written ahead of it.
+TEST(RecorderTest, ReceiveStampsOutOfOrderAreWrittenAscending) {
+  AscendingStamps stamps;
+  std::vector<std::int64_t> written;
+  for (std::int64_t received : {1'000'300, 1'000'100, 1'000'200, 1'000'400, 1'000'350, 1'000'500})
+    written.push_back(stamps.stamp(received));
+  EXPECT_EQ(written, (std::vector<std::int64_t>{1'000'300, 1'000'300, 1'000'300, 1'000'400, 1'000'400, 1'000'500}));
+  EXPECT_EQ(stamps.restamped(), 3u);
+  AscendingStamps in_order;
+  for (std::int64_t received : {5, 5, 6, 9}) EXPECT_EQ(in_order.stamp(received), received);
+  EXPECT_EQ(in_order.restamped(), 0u);
 }
 
 TEST(RecorderTest, StopsAfterTheDuration) {

@@ -60,14 +60,14 @@ TEST(RegionsCli, JsonDescribesEveryHullVertexAndConsistentRegions) {
 
 TEST(RegionsCli, HeadAttachedPanelErrorIsNotTheHeadTrackersAsInTheRootModel) {
   const nlohmann::json exact = run_json();
-  const nlohmann::json seed = run_json("--propagation osgar-matrix16");
+  const nlohmann::json osgar = run_json("--propagation osgar-matrix16");
   const double exact_panel = object(exact, "hud_panel")["assessment_px"];
-  const double seed_panel = object(seed, "hud_panel")["assessment_px"];
+  const double osgar_panel = object(osgar, "hud_panel")["assessment_px"];
   const double exact_table = object(exact, "table")["assessment_px"];
   std::printf("hud_panel error: exact %.2f px, root model %.2f px (%.1fx); table %.2f px\n",
-              exact_panel, seed_panel, seed_panel / exact_panel, exact_table);
+              exact_panel, osgar_panel, osgar_panel / exact_panel, exact_table);
   // The dissertation's section 4.9.1 model measured 5-78x too large on such a chain.
-  EXPECT_GT(seed_panel, 5 * exact_panel);
+  EXPECT_GT(osgar_panel, 5 * exact_panel);
   // The world object sees the 2-degree head tracker: far more error than the panel.
   EXPECT_GT(exact_table, 5 * exact_panel);
 }

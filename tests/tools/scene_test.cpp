@@ -5,8 +5,10 @@
 #include <sstream>
 
 #include "covtrack/scene/scene.hpp"
+#include "covtrack/scene/scene_graph.hpp"
 
 using covtrack::scene::parse_scene;
+using covtrack::scene::scripted_value;
 
 namespace {
 std::string error_of(const std::string& text) {
@@ -83,6 +85,32 @@ TEST(Scene, KeyframesInterpolateAndRepeat) {
   EXPECT_NEAR(at(5).T_parent_child.translation().x(), at(1).T_parent_child.translation().x(), 1e-12);
   EXPECT_NEAR(at(4).T_parent_child.translation().x(), 1, 1e-12);
   EXPECT_NEAR(at(-1).T_parent_child.translation().x(), at(3).T_parent_child.translation().x(), 1e-12);
+}
+
+// A keyframe can script the tracker losing the object: from its time to the next keyframe
+// the edge's report is LOST, and what hangs below it is infinitely uncertain.
+TEST(Scene, KeyframesCanScriptALostTracker) {
+  const std::string text = kCamera + kTracked +
+                           "[[transform.keyframe]]\nt_s = 0\n"
+                           "[[transform.keyframe]]\nt_s = 1\nlost = true\n"
+                           "[[transform.keyframe]]\nt_s = 2\n"
+                           "[[transform.keyframe]]\nt_s = 3\n";
+  auto s = parse_scene(text, "k.toml", ".");
+  ASSERT_TRUE(s) << s.error().message;
+  const covtrack::scene::SceneTransform& t = s->transforms[0];
+  for (double time_s : {0.0, 0.9, 2.0, 2.5, 3.5}) EXPECT_FALSE(scripted_value(t, time_s).lost) << time_s;
+  for (double time_s : {1.0, 1.5, 1.99, 4.5}) EXPECT_TRUE(scripted_value(t, time_s).lost) << time_s;
+
+  for (const auto& [time_s, lost] : {std::pair{0.5, false}, std::pair{1.5, true}}) {
+    covtrack::client::TransformGraph graph;
+    ASSERT_TRUE(covtrack::scene::add_scene_transforms(*s, graph, 0));
+    ASSERT_TRUE(covtrack::scene::report_keyframes(*s, graph, time_s, 0));
+    auto pose = graph.query("c", "t", 0);
+    ASSERT_TRUE(pose) << pose.error().message;
+    EXPECT_EQ(pose->unbounded, lost) << time_s;
+    if (!lost) EXPECT_NEAR(std::sqrt(pose->covariance(0, 0)), 0.1, 1e-9);
+  }
+  EXPECT_FALSE(parse_scene(kCamera + kTracked + "[[transform.keyframe]]\nt_s = 0\nlost = 1\n", "k.toml", "."));
 }
 
 TEST(Scene, WidgetKeysAndTheirMistakes) {

@@ -47,7 +47,7 @@ std::string model_file_text(const fiducial::CornerNoiseModel& m, const Calibrate
 }
 
 void print_fit(const fiducial::BoardFit& fit, const fiducial::CornerNoiseModel& start) {
-  fmt::print("{} tag views fitted from {} frames ({} left out: beyond chi-square(8)'s 99.9% quantile); median edge "
+  fmt::print("{} tag views fitted from {} frames ({} left out as gross errors: residual NEES above 100); median edge "
              "blur {:.2f} px\n",
              fit.residuals, fit.frames_used, fit.left_out, fit.median_blur_px);
   fmt::print("  {:<34} {:>9} {:>9}\n", "", "before", "fitted");

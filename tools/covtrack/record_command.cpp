@@ -52,6 +52,9 @@ void print_summary(const lcmlog::RecordSummary& s, const std::string& path) {
              s.duration_s, path);
   for (const auto& [channel, count] : s.events_per_channel)
     fmt::print(stderr, "  {:<63} {}\n", channel, count);
+  if (s.restamped > 0)
+    fmt::print(stderr, "covtrack record: {} events arrived stamped earlier than the event before them; "
+                       "written with that event's time, so the log is in time order\n", s.restamped);
   if (s.bad_messages.total > 0)
     fmt::print(stderr, "covtrack record: warning: messages that fail the covtrack wire checks, recorded as they came: {}\n",
                s.bad_messages.summary());

@@ -164,8 +164,8 @@ void add_regions_command(CLI::App& app) {
       ->transform(program::one_of(methods));
   const std::map<std::string, client::Propagation> propagations = {
       {"lca", client::Propagation::LowestCommonAncestor},
-      {"osgar-root", client::Propagation::SeedRoot},
-      {"osgar-matrix16", client::Propagation::SeedMatrix16}};
+      {"osgar-root", client::Propagation::OsgarRoot},
+      {"osgar-matrix16", client::Propagation::OsgarMatrix16}};
   cmd->add_option("--propagation", args->propagation,
                   "lca (exact, default); osgar-root or osgar-matrix16: osgAR's propagation from the root (docs/background.md), "
                   "kept to compare against: it gives objects attached to a tracked frame an error they do not have")

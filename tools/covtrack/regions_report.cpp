@@ -22,6 +22,7 @@ std::vector<std::string> flag_names(const client::ProjectionFlags& f) {
   if (f.rotation_too_uncertain) names.push_back("rotation_too_uncertain");
   if (f.unbounded) names.push_back("unbounded");
   if (f.covariance_repaired) names.push_back("covariance_repaired");
+  if (f.past_distortion_fold) names.push_back("past_distortion_fold");
   return names;
 }
 

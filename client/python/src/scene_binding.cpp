@@ -26,8 +26,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 client::Propagation propagation_of(const std::string& name) {
   if (name == "lca") return client::Propagation::LowestCommonAncestor;
-  if (name == "osgar-root") return client::Propagation::SeedRoot;
-  if (name == "osgar-matrix16") return client::Propagation::SeedMatrix16;
+  if (name == "osgar-root") return client::Propagation::OsgarRoot;
+  if (name == "osgar-matrix16") return client::Propagation::OsgarMatrix16;
   throw py::value_error("propagation must be 'lca', 'osgar-root' or 'osgar-matrix16', not '" + name + "'");
 }
 

@@ -32,11 +32,15 @@ Pose read_pose(TableReader& r) {
         T.linear() = quat.toRotationMatrix();
     }
   } else if (r.has("rotation_rpy_deg")) {
-    const Vec3 rpy = r.vec3("rotation_rpy_deg") * std::numbers::pi / 180;
-    T.linear() = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
-                  Eigen::AngleAxisd(rpy.x(), Vec3::UnitX())).toRotationMatrix();
+    T.linear() = rotation_from_rpy_deg(r.vec3("rotation_rpy_deg"));
   }
   return T;
+}
+
+Mat3 rotation_from_rpy_deg(const Vec3& rpy_deg) {
+  const Vec3 rpy = rpy_deg * std::numbers::pi / 180;
+  return (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
+          Eigen::AngleAxisd(rpy.x(), Vec3::UnitX())).toRotationMatrix();
 }
 
 }  // namespace covtrack

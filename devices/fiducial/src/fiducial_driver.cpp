@@ -149,7 +149,7 @@ class FiducialDriver final : public Driver {
       if (posed.count(sensor)) continue;
       PoseSample s{sensor, config_.parent_frame, sensor, time_us};
       s.T_parent_child = last;
-      s.covariance = Mat6::Identity() * std::numeric_limits<double>::infinity();
+      s.covariance = lost_covariance();
       s.status = TrackingStatus::Lost;
       sink.pose(s);
     }

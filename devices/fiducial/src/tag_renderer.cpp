@@ -76,11 +76,20 @@ cv::Mat render_tags(const CameraModel& camera, const TagFamily& family,
                                    0, S, (S - 1) / 2.0 - S * roi.y,  //
                                    0, 0, 1);
     const cv::Matx33d H = image_to_sub * plane_to_image(camera, tag.T_camera_tag) * texel_to_plane;
-    cv::Mat fine(roi.height * S, roi.width * S, CV_32F, cv::Scalar(look.background));
+    // The printed tag and its footprint (1 where a sub-sample lies on it), both averaged
+    // down, so that only what the tag covers is replaced: on a rolled board, neighbouring
+    // tags' bounding boxes overlap, and pasting the whole box (background included) cut
+    // the corners off the tags drawn before (their edges were then off by up to 1 px).
+    cv::Mat fine(roi.height * S, roi.width * S, CV_32F, cv::Scalar(0));
+    cv::Mat footprint = fine.clone();
     cv::warpPerspective(texture, fine, H, fine.size(), cv::INTER_LINEAR, cv::BORDER_TRANSPARENT);
-    cv::Mat coarse;
+    cv::warpPerspective(cv::Mat(texture.size(), CV_32F, cv::Scalar(1)), footprint, H, fine.size(), cv::INTER_LINEAR,
+                        cv::BORDER_TRANSPARENT);
+    cv::Mat coarse, covered;
     cv::resize(fine, coarse, roi.size(), 0, 0, cv::INTER_AREA);
-    coarse.copyTo(image(roi));
+    cv::resize(footprint, covered, roi.size(), 0, 0, cv::INTER_AREA);
+    const cv::Mat blended = image(roi).mul(1 - covered) + coarse;
+    blended.copyTo(image(roi));
   }
   if (look.blur_sigma_px > 0) cv::GaussianBlur(image, image, {0, 0}, look.blur_sigma_px);
   return image;

@@ -37,7 +37,7 @@ std::vector<PoseSample> HydraStream::lost(std::int64_t time_us) {
     PoseSample s{config_.sensors[i], config_.parent_frame, config_.sensors[i], time_us};
     s.status = TrackingStatus::Lost;  // LOST carries no information: infinite covariance
     s.T_parent_child = last_[i];
-    s.covariance = Mat6::Identity() * std::numeric_limits<double>::infinity();
+    s.covariance = lost_covariance();
     gates_[i].restart();
     out.push_back(s);
   }

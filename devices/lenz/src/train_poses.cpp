@@ -35,7 +35,7 @@ std::vector<PoseSample> train_poses(const TrackLayout& layout, const AlongTrack&
     if (along.state == AlongTrack::State::Lost) {
       p.status = TrackingStatus::Lost;
       p.T_parent_child = last[k];
-      p.covariance = Mat6::Identity() * std::numeric_limits<double>::infinity();
+      p.covariance = lost_covariance();
     } else {
       const double s = along.mid_s() - layout.train().offset_behind_m(k);
       p.status = TrackingStatus::Degraded;  // dead reckoning, always

@@ -155,7 +155,7 @@ class Serial6dofDriver final : public Driver {
     PoseSample s{st.name, config_.parent_frame, st.name, now_us()};
     s.status = TrackingStatus::Lost;  // LOST carries no information: infinite covariance
     s.T_parent_child = stations_[i].last_estimate;
-    s.covariance = Mat6::Identity() * std::numeric_limits<double>::infinity();
+    s.covariance = lost_covariance();
     stations_[i].lost = true;
     stations_[i].last_lost_report = now;  // the gate restarts by itself after a long silence
     sink.pose(s);

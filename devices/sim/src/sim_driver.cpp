@@ -69,7 +69,7 @@ class SimDriver final : public Driver {
         // LOST carries no information: the last estimate, infinitely uncertain.
         s.status = TrackingStatus::Lost;
         s.T_parent_child = last_estimate_[i];
-        s.covariance = Mat6::Identity() * std::numeric_limits<double>::infinity();
+        s.covariance = lost_covariance();
       } else {
         s.T_parent_child = T_true * se3_exp(-noise_.draw(rng_));
         s.covariance = config_.covariance;

@@ -167,7 +167,7 @@ class VrpnDriver final : public Driver {
     PoseSample lost{s.name, config_.parent_frame, s.name, now_us()};
     lost.status = TrackingStatus::Lost;
     lost.T_parent_child = s.last;
-    lost.covariance = Mat6::Identity() * std::numeric_limits<double>::infinity();
+    lost.covariance = lost_covariance();
     sink.pose(lost);
     s.reported = false;
   }

@@ -37,10 +37,11 @@ void Recorder::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& cha
   // it is LCM's plumbing, not part of the session.
   if (write_error_ || channel == kLcmSelfTestChannel) return;
   const std::span payload(static_cast<const std::byte*>(rbuf->data), rbuf->data_size);
-  if (auto ok = writer_.write(rbuf->recv_utime, channel, payload); !ok) {
+  if (auto ok = writer_.write(stamps_.stamp(rbuf->recv_utime), channel, payload); !ok) {
     write_error_ = ok.error();
     return;
   }
+  summary_.restamped = stamps_.restamped();
   ++summary_.events;
   summary_.bytes += kEventHeaderBytes + channel.size() + rbuf->data_size;
   ++summary_.events_per_channel[channel];

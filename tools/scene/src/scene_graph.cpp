@@ -13,8 +13,8 @@ client::TrackedTransform report_of(const SceneTransform& t, std::int64_t measure
   report.parent_frame = t.parent;
   report.child_frame = t.child;
   report.T_parent_child = t.T_parent_child;
-  report.covariance = t.covariance;
-  report.status = TrackingStatus::Ok;
+  report.covariance = t.lost ? lost_covariance() : t.covariance;
+  report.status = t.lost ? TrackingStatus::Lost : TrackingStatus::Ok;
   report.measurement_time_us = report.publish_time_us = report.receive_time_us = measured_us;
   return report;
 }

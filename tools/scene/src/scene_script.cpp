@@ -19,6 +19,7 @@ SceneTransform scripted_value(const SceneTransform& t, double scene_time_s) {
   out.T_parent_child.translation() = a.position_m + f * (b.position_m - a.position_m);
   const double scale = a.sigma_scale + f * (b.sigma_scale - a.sigma_scale);
   out.covariance = t.covariance * (scale * scale);
+  out.lost = a.lost;  // a status holds until the next keyframe; it does not blend
   return out;
 }
 

@@ -47,6 +47,12 @@ struct Camera {
     d[3] = fy * (radial + y * drad_dy + 6 * p1 * y + 2 * p2 * x);
   }
 
+  // Where the radial distortion folds back: the smallest r^2 = x^2 + y^2 (normalised) at
+  // which the distorted radius r (1 + k1 r^2 + k2 r^4 + k3 r^6) stops growing with r.
+  // Points beyond it land back inside the image at a wrong pixel. Infinity when the
+  // model never folds (tangential terms are small there and left out).
+  double distortion_fold_r2() const;
+
   // First-order screen covariance (px^2) due to the intrinsic sigmas, at this point.
   Mat2 intrinsic_covariance(const Vec3& p_camera) const { return intrinsic_covariance_at(project(p_camera)); }
   // The same from the point's pixel (it depends on nothing else).

@@ -46,12 +46,17 @@ struct ProjectionFlags {
   bool rotation_too_uncertain = false;     // see max_rotation_sigma_rad
   bool unbounded = false;                  // input pose is LOST: covariance meaningless
   bool covariance_repaired = false;        // UT gave an indefinite matrix; clipped to PSD
+  // The vertex, or one of its sigma points, lies past the lens model's distortion fold
+  // (Camera::distortion_fold_r2): its pixel is not where the point appears.
+  bool past_distortion_fold = false;
 
   // The mean and covariance describe the vertex (the other flags are warnings).
-  bool usable() const { return !behind_camera && !sigma_point_behind_camera && !unbounded; }
+  bool usable() const {
+    return !behind_camera && !sigma_point_behind_camera && !unbounded && !past_distortion_fold;
+  }
   bool any() const {
     return behind_camera || sigma_point_behind_camera || rotation_too_uncertain ||
-           unbounded || covariance_repaired;
+           unbounded || covariance_repaired || past_distortion_fold;
   }
   // Inline: it runs for every vertex of every object, and a call cost more than the ors.
   ProjectionFlags& operator|=(const ProjectionFlags& o) {
@@ -60,6 +65,7 @@ struct ProjectionFlags {
     rotation_too_uncertain |= o.rotation_too_uncertain;
     unbounded |= o.unbounded;
     covariance_repaired |= o.covariance_repaired;
+    past_distortion_fold |= o.past_distortion_fold;
     return *this;
   }
 };

@@ -6,7 +6,7 @@
 // Propagation: through the lowest common ancestor (LCA) of A and B with exact first-order
 // SE(3) Jacobians (graph_chain.hpp), so edges above the LCA, shared by both paths, never
 // enter. The root-based models of the osgAR dissertation (docs/background.md) stay
-// available for comparison only (Propagation::SeedRoot, Propagation::SeedMatrix16).
+// available for comparison only (Propagation::OsgarRoot, Propagation::OsgarMatrix16).
 //
 // Edges are independent of each other. A tracked edge's covariance grows with the age of
 // its last report (graph_staleness.hpp); a LOST or never reported edge on the path makes
@@ -41,11 +41,11 @@ namespace covtrack::client {
 
 enum class Propagation {
   LowestCommonAncestor,  // exact first-order Jacobians through the LCA (use this)
-  SeedRoot,              // exact Jacobians, but A and B each from the root, taken as
+  OsgarRoot,              // exact Jacobians, but A and B each from the root, taken as
                          // independent: the dissertation's section 4.9.1 flaw, isolated
-  SeedMatrix16,          // the dissertation's additive 16-element matrix model (appendix B,
+  OsgarMatrix16,          // the dissertation's additive 16-element matrix model (appendix B,
                          // eq. 29), from the root, converted to 6x6 BODY
-                         // (graph_seed_matrix16.hpp)
+                         // (graph_osgar_matrix16.hpp)
 };
 
 struct StaticSource {

@@ -11,6 +11,11 @@ namespace covtrack {
 enum class TrackingStatus : std::int8_t { Ok = 0, Degraded = 1, Lost = 2 };
 const char* to_string(TrackingStatus status);
 
+// The covariance a LOST report carries: +infinity on the diagonal, 0 elsewhere
+// (protocol/README.md). Built entry by entry because Identity() * infinity puts
+// 0 * inf = NaN off the diagonal.
+Mat6 lost_covariance();
+
 Pose pose_of(const pose_cov_t& msg);
 Pose pose_of(const truth_pose_t& msg);
 // The message's covariance, converted to the canonical BODY convention.

@@ -14,4 +14,7 @@ std::vector<KeySpec> pose_keys();
 // go to the reader's errors and the identity rotation stands in.
 Pose read_pose(TableReader& r);
 
+// rotation_rpy_deg's rotation: R = Rz(yaw) Ry(pitch) Rx(roll), angles in degrees.
+Mat3 rotation_from_rpy_deg(const Vec3& rpy_deg);
+
 }  // namespace covtrack

@@ -24,6 +24,33 @@ struct RecordSummary {
   // Messages of covtrack channels that fail the wire checks (check_channel_message()):
   // recorded as they came, since a log is evidence, and counted here by reason.
   RejectionTally bad_messages;
+  // Events whose receive stamp was earlier than the event before them: written with that
+  // event's stamp instead, so the log is in timestamp order (AscendingStamps).
+  std::uint64_t restamped = 0;
+};
+
+// Stamps that never go back: events are written in the order they are handled, and a
+// log's readers (lcm-logplayer, replay, lcm-spy) expect their stamps to ascend. LCM's
+// receive stamps (the kernel's SO_TIMESTAMP) do not always: the kernel turns stamping on a
+// moment after the socket asks, and a datagram that arrived before is stamped when read,
+// after later arrivals (seen on the first few events of a session). Such an event keeps
+// its place and takes the stamp of the event before it.
+class AscendingStamps {
+ public:
+  std::int64_t stamp(std::int64_t received_us) {
+    if (any_ && received_us < last_us_) {
+      ++restamped_;
+      return last_us_;
+    }
+    any_ = true;
+    return last_us_ = received_us;
+  }
+  std::uint64_t restamped() const { return restamped_; }
+
+ private:
+  bool any_ = false;
+  std::int64_t last_us_ = 0;
+  std::uint64_t restamped_ = 0;
 };
 
 // LCM's default per-subscription queue of 30 drops the newest message silently when
@@ -50,6 +77,7 @@ class Recorder {
   lcm::Subscription* subscription_ = nullptr;
   RecordSummary summary_;
   std::optional<Error> write_error_;
+  AscendingStamps stamps_;
 };
 
 }  // namespace covtrack::lcmlog

@@ -18,6 +18,7 @@ struct Keyframe {
   double t_s = 0;
   Vec3 position_m = Vec3::Zero();  // the edge's position_m unless the keyframe sets it
   double sigma_scale = 1;          // multiplies the edge's sigmas (covariance by its square)
+  bool lost = false;               // the tracker reports LOST from t_s to the next keyframe
 };
 
 struct SceneTransform {
@@ -31,6 +32,7 @@ struct SceneTransform {
   // Offline only (no --live, no --log): the reports its tracker would send, repeated with
   // the period of the last keyframe's t_s. Empty: the edge's fixed value.
   std::vector<Keyframe> keyframes;
+  bool lost = false;  // a scripted value: the report at this time is LOST
 };
 
 // Level-of-Error augmentations `covtrack view` can draw (dissertation 5.6.2,

@@ -19,7 +19,7 @@
 // white-cell shift's residual W are kept: a board cannot separate them from kI): the
 // camera's level of each error, the shape in blur, size and contrast kept from the
 // population calibration (one camera seldom spans enough blur to fit the shape).
-// A residual beyond chi-square(8)'s 99.9% quantile under the fit (a wrong quad, a tag
+// A residual whose NEES under the fit is above 100 (a gross error: a wrong quad, a tag
 // peeled off the board) is left out and the fit repeated once. devices/fiducial/README.md,
 // "Per-camera calibration".
 #include <vector>

@@ -1,4 +1,4 @@
-#include "covtrack/client/graph_seed_matrix16.hpp"
+#include "covtrack/client/graph_osgar_matrix16.hpp"
 
 #include <unsupported/Eigen/KroneckerProduct>
 
@@ -44,7 +44,7 @@ Mat6 body_from_matrix16(const Pose& T, const Mat16& covariance) {
   return 0.5 * (out + out.transpose());
 }
 
-MatrixEstimate seed_propagate(const MatrixEstimate& parent, const Pose& T_parent_child,
+MatrixEstimate osgar_propagate(const MatrixEstimate& parent, const Pose& T_parent_child,
                               const Mat6& body_covariance) {
   const Mat4 M = T_parent_child.matrix();
   // dN_j = dN_i M + N_i dM
@@ -57,7 +57,7 @@ MatrixEstimate seed_propagate(const MatrixEstimate& parent, const Pose& T_parent
   return out;
 }
 
-UncertainPose seed_relative(const MatrixEstimate& root_A, const MatrixEstimate& root_B) {
+UncertainPose osgar_relative(const MatrixEstimate& root_A, const MatrixEstimate& root_B) {
   const Mat4 inv_A = root_A.N.inverse();
   const Mat4 T = inv_A * root_B.N;
   // d(inv(N_A) N_B) = -inv(N_A) dN_A inv(N_A) N_B + inv(N_A) dN_B

@@ -31,9 +31,9 @@ Mat16 matrix16_from_body(const Pose& T, const Mat6& body);
 Mat6 body_from_matrix16(const Pose& T, const Mat16& covariance);
 
 // One step of eq. 29: the root-to-child estimate from the root-to-parent one.
-MatrixEstimate seed_propagate(const MatrixEstimate& parent, const Pose& T_parent_child,
+MatrixEstimate osgar_propagate(const MatrixEstimate& parent, const Pose& T_parent_child,
                               const Mat6& body_covariance);
 // T_A_B = inv(N_A) N_B with the two root-path errors taken as independent (eq. 6).
-UncertainPose seed_relative(const MatrixEstimate& root_A, const MatrixEstimate& root_B);
+UncertainPose osgar_relative(const MatrixEstimate& root_A, const MatrixEstimate& root_B);
 
 }  // namespace covtrack::client
