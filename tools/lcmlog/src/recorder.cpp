@@ -41,7 +41,6 @@ void Recorder::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& cha
     write_error_ = ok.error();
     return;
   }
-  summary_.restamped = stamps_.restamped();
   ++summary_.events;
   summary_.bytes += kEventHeaderBytes + channel.size() + rbuf->data_size;
   ++summary_.events_per_channel[channel];
@@ -75,6 +74,7 @@ Result<RecordSummary> Recorder::run(int stop_fd, std::optional<double> duration_
   }
   if (write_error_) return std::unexpected(*write_error_);
   summary_.duration_s = std::chrono::duration<double>(Clock::now() - started).count();
+  summary_.restamped = stamps_.restamped();
   return summary_;
 }
 
