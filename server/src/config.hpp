@@ -38,7 +38,7 @@ struct DaemonConfig {
 // What a config load checks beyond the config itself.
 enum class ResourceChecks {
   Skip,  // at start: a missing device may appear later; its driver retries it
-  Run,   // --check: every file, folder and device node the devices name must open
+  Run,   // --check: every file and folder the devices name must open (devices are not opened)
 };
 
 // On failure the error holds every problem found, one per line, each as

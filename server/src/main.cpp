@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
   bool check_only = false, print_schema = false, allow_duplicates = false;
   app.add_option("--config,-c", config_path, "daemon config (TOML; a file or a pipe), e.g. config/sim.toml");
   app.add_option("--lcm-url,-u", lcm_url, "LCM URL (overrides the config's daemon.lcm_url)");
-  app.add_flag("--check", check_only, "validate the config, open every file and device it names, and exit");
+  app.add_flag("--check", check_only, "validate the config, open every file it names (not devices: a serial port, camera or HID device may be plugged in later), and exit");
   app.add_flag("--print-schema", print_schema, "print the config schema (Markdown) and exit");
   app.add_flag("--allow-duplicate-publishers", allow_duplicates,
                "publish devices that another daemon already publishes (sets daemon.allow_duplicate_publishers)");
@@ -54,8 +54,8 @@ int main(int argc, char** argv) {
     std::cerr << "covtrackd: --config FILE is required (try config/sim.toml)\n";
     return kExitUsageError;
   }
-  // --check also opens what the devices name (files, folders, device nodes); a start
-  // does not, as a device missing now may appear later and its driver retries it.
+  // --check also opens the files the devices name (image sequences, videos, calibrations);
+  // a start does not, as a file missing now may appear later and its driver retries it.
   auto config = covtrack::server::load_config(
       config_path, check_only ? covtrack::server::ResourceChecks::Run : covtrack::server::ResourceChecks::Skip);
   if (!config) {

@@ -2,11 +2,14 @@
 
 #include <deque>
 #include <filesystem>
+#include <map>
+#include <set>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "covtrack/devices/device_keys.hpp"
+#include "covtrack/devices/fiducial/camera_model.hpp"
 #include "covtrack/devices/fiducial/frame_source.hpp"
 #include "covtrack/devices/pose_keys.hpp"
 #include "covtrack/protocol/channels.hpp"
@@ -19,9 +22,10 @@ const TableSpec& fiducial_device_spec() {
     const std::vector<KeySpec> own = {
         {"source", ValueType::String, "", "", "camera: V4L2 index (\"0\"); or image files: a "
          "pattern (\"frames/frame_%04d.png\", numbered from 0 or 1) or one image; or a video file; "
-         "relative to this file; `covtrackd --check` opens it"},
+         "relative to this file; `covtrackd --check` opens files, not a camera (it may be plugged in later)"},
         {"calibration", ValueType::String, "", "", "camera calibration: OpenCV's file (camera_matrix, "
-         "distortion_coefficients, image_width, image_height) or ROS's camera_info YAML; relative to this file"},
+         "distortion_coefficients, image_width, image_height) or ROS's camera_info YAML; relative to this file; "
+         "`covtrackd --check` reads it"},
         {"family", ValueType::String, "", "\"tag36h11\"", "AprilTag family"},
         {"decimate", ValueType::Float, "", "2", "quad search on an image this much smaller", 1, 8},
         {"quad_sigma", ValueType::Float, "px", "0", "blur before the quad search (0.8 speeds up "
@@ -205,9 +209,17 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
   c.device = device_name;
   c.parent_frame = r.string("parent_frame", "world");
   c.source = r.string("source");
-  if (!is_camera_index(c.source)) c.source = relative_to_config(c.source, r.file());
-  r.resource("source", [source = c.source] { return check_frame_source(source); });
+  // --check opens the files a config names, not devices: a config written for a camera
+  // checks on a machine without it (as a serial port or HID device is not opened either).
+  if (!is_camera_index(c.source)) {
+    c.source = relative_to_config(c.source, r.file());
+    r.resource("source", [source = c.source] { return check_frame_source(source); });
+  }
   c.calibration = relative_to_config(r.string("calibration"), r.file());
+  r.resource("calibration", [file = c.calibration]() -> Result<void> {
+    if (auto camera = load_camera_model(file); !camera) return std::unexpected(camera.error());
+    return {};
+  });
   c.detector.family = r.string("family", "tag36h11");
   bool known = false;
   for (const auto& f : tag_family_names()) known |= f == c.detector.family;
@@ -245,19 +257,20 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
   std::map<int, std::string> owner;  // who claims each tag id
   for (const auto& [id, size] : c.tag_size_m) owner[id] = kTagMap;
   std::deque<TableReader> bundle_readers;  // kept for the checks that need every bundle read
+  std::set<std::string> bundle_names;  // one error per repeated name, not one per pair
   for (const toml::table* t : r.tables("bundles")) {
     TableReader& br = bundle_readers.emplace_back(
         *t, r.path(fmt::format("bundles[{}]", bundle_readers.size())), fiducial_bundle_spec(), r.file(), r.errors());
     TagBundle b = read_bundle(br, owner);
-    for (const TagBundle& other : c.bundles)
-      if (other.name == b.name) br.error("name", fmt::format("bundle '{}' is named twice", b.name));
+    if (!bundle_names.insert(b.name).second) br.error("name", fmt::format("bundle '{}' is named twice", b.name));
     c.bundles.push_back(b);
   }
   // A bundle named like a tag's sensor would share its stream.
+  std::map<std::string, int> tag_sensors;
+  for (const auto& [id, claimant] : owner) tag_sensors[fmt::format("tag{}", id)] = id;
   for (std::size_t i = 0; i < c.bundles.size(); ++i)
-    for (const auto& [id, claimant] : owner)
-      if (c.bundles[i].name == fmt::format("tag{}", id))
-        bundle_readers[i].error("name", fmt::format("'{}' is the sensor name of tag {}", c.bundles[i].name, id));
+    if (const auto tag = tag_sensors.find(c.bundles[i].name); tag != tag_sensors.end())
+      bundle_readers[i].error("name", fmt::format("'{}' is the sensor name of tag {}", tag->first, tag->second));
   if (c.tag_size_m.empty() && c.bundles.empty())
     r.error("tags", "needs at least one [[tags]] entry (id, size_m) or [[bundles]] entry");
   return c;
