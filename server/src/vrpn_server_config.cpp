@@ -120,12 +120,12 @@ std::optional<VrpnServerConfig> read_vrpn_server(TableReader& top,
   c.udp = r.boolean("udp", c.udp);
   c.max_clients = static_cast<int>(r.integer("max_clients", c.max_clients));
   c.max_queued_bytes = static_cast<std::size_t>(r.integer("max_queued_bytes", static_cast<std::int64_t>(c.max_queued_bytes)));
+  std::set<std::string> names;  // one error per repeated tracker, not one per pair
   for (const toml::table* t : r.tables("trackers")) {
     TableReader tr(*t, fmt::format("vrpn_server.trackers[{}]", c.trackers.size()), vrpn_server_tracker_spec(),
                    top.file(), top.errors());
     VrpnTrackerConfig tracker = read_tracker(tr, device_frames);
-    for (const auto& other : c.trackers)
-      if (other.name == tracker.name) tr.error("name", fmt::format("tracker '{}' is served twice", tracker.name));
+    if (!names.insert(tracker.name).second) tr.error("name", fmt::format("tracker '{}' is served twice", tracker.name));
     c.trackers.push_back(std::move(tracker));
   }
   if (r.has("trackers") && c.trackers.empty()) r.error("trackers", "serves no tracker: add [[vrpn_server.trackers]]");

@@ -2,11 +2,18 @@
 // all of them at once, and nothing starts.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "config.hpp"
 
@@ -160,6 +167,101 @@ TEST(Config, ADeviceOrAFolderIsRefusedAsAConfig) {
     EXPECT_NE(r.error().message.find(path + ": is a "), std::string::npos) << r.error().message;
     EXPECT_NE(r.error().message.find(", not a file to read"), std::string::npos) << r.error().message;
   }
+}
+
+// Found by mutation fuzzing (tests/server/config_mutation_fuzz.py): a config repeating a
+// serial station, VRPN sensor, served tracker or tag bundle thousands of times got one
+// error per pair of repeats (3,000 stations: 4.5 million errors, 3.8 GB, a minute). Now
+// each repeat is one error.
+TEST(Config, EachRepeatedTableIsOneError) {
+  const auto repeated = [](const std::string& head, const std::string& table, int times) {
+    std::string text = head;
+    for (int i = 0; i < times; ++i) text += table;
+    return text;
+  };
+  struct Case {
+    std::string text, error;
+  };
+  const std::string frames = COVTRACK_SOURCE_DIR "/config/cameras/rendered_640x480.yml";
+  const std::vector<Case> cases = {
+      {repeated("[devices.f]\ntype = \"fastrak\"\nport = \"/dev/null\"\n",
+                "[[devices.f.stations]]\nnumber = 1\nname = \"a\"\n", 4),
+       "station 1 is listed twice"},
+      {repeated("[devices.v]\ntype = \"vrpn\"\ntracker = \"T@localhost\"\nsigma_m = [0.001, 0.001, 0.001]\n"
+                "sigma_rad = [0.001, 0.001, 0.001]\n",
+                "[[devices.v.sensors]]\nnumber = 0\nname = \"a\"\n", 4),
+       "sensor 0 is listed twice"},
+      {repeated(std::string(kGoodDevice) + "[vrpn_server]\n",
+                "[[vrpn_server.trackers]]\nname = \"T\"\nstreams = [\"opt/head\"]\n", 4),
+       "tracker 'T' is served twice"},
+      {repeated("[devices.d]\ntype = \"fiducial\"\nsource = \"0\"\ncalibration = \"" + frames + "\"\n",
+                "[[devices.d.bundles]]\nname = \"b\"\n[[devices.d.bundles.tags]]\nid = 1\nsize_m = 0.1\n", 4),
+       "bundle 'b' is named twice"},
+  };
+  for (const Case& c : cases) {
+    auto r = parse_config(c.text, "repeats.toml");
+    ASSERT_FALSE(r) << c.text;
+    const std::string& m = r.error().message;
+    std::size_t count = 0;
+    for (auto at = m.find(c.error); at != std::string::npos; at = m.find(c.error, at + 1)) ++count;
+    EXPECT_EQ(count, 3u) << "three repeats of the first, one error each:\n" << m;
+  }
+}
+
+// A sim device lists at most 64 sensors, each once (as sensor_count allows): 100,000
+// names (found by mutation fuzzing) made a device that did not stop in time.
+TEST(Config, SimSensorsAreAtMost64AndDistinct) {
+  std::string many = "[devices.s]\ntype = \"sim\"\nsigma_m = [0.001, 0.001, 0.001]\nsigma_rad = [0.001, 0.001, 0.001]\n"
+                     "sensors = [";
+  for (int i = 0; i < 65; ++i) many += "\"s" + std::to_string(i) + "\", ";
+  expect_has(only_error(many + "]\n"), "bad.toml:5:11: devices.s.sensors: 65 sensors: at most 64");
+  const std::string twice = "[devices.s]\ntype = \"sim\"\nsigma_m = [0.001, 0.001, 0.001]\n"
+                            "sigma_rad = [0.001, 0.001, 0.001]\nsensors = [\"a\", \"b\", \"a\"]\n";
+  expect_has(only_error(twice), "bad.toml:5:11: devices.s.sensors: 'a' is listed twice");
+}
+
+// However many problems a config has, the report shows the first 100 and says so.
+TEST(Config, AtMost100ProblemsAreShown) {
+  std::string text = kGoodDevice;
+  for (int i = 0; i < 500; ++i) text += "bogus_" + std::to_string(i) + " = 1\n";
+  auto r = parse_config(text, "many.toml");
+  ASSERT_FALSE(r);
+  const std::string& m = r.error().message;
+  EXPECT_EQ(std::count(m.begin(), m.end(), '\n'), 101) << m.substr(0, 2000);
+  expect_has(m, ": unknown key");
+  expect_has(m, "(only the first 100 problems are shown)\n");
+}
+
+// A config (or a track layout) is read to at most 4 MiB: a bigger file, or a pipe fed
+// without end, is refused instead of taking the daemon's memory.
+TEST(Config, AFileOrPipeOver4MiBIsRefused) {
+  const std::string big = ::testing::TempDir() + "/covtrack_big_config.toml";
+  {
+    std::ofstream out(big);
+    out << kGoodDevice;
+    const std::string comment = "# " + std::string(1000, 'x') + "\n";
+    for (int i = 0; i < 4200; ++i) out << comment;
+  }
+  auto r = covtrack::server::load_config(big);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message, big + ": is larger than 4 MiB, too large for a config file");
+
+  const std::string fifo = ::testing::TempDir() + "/covtrack_endless_config_" + std::to_string(getpid());
+  ::unlink(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::signal(SIGPIPE, SIG_IGN);  // the writer sees EPIPE when the reader gives up
+  std::thread writer([&] {
+    const int fd = ::open(fifo.c_str(), O_WRONLY);
+    const std::string line = "# endless\n";
+    while (fd >= 0 && ::write(fd, line.data(), line.size()) > 0) {
+    }
+    if (fd >= 0) ::close(fd);
+  });
+  auto endless = covtrack::server::load_config(fifo);
+  writer.join();
+  ::unlink(fifo.c_str());
+  ASSERT_FALSE(endless);
+  EXPECT_EQ(endless.error().message, fifo + ": is larger than 4 MiB, too large for a config file");
 }
 
 TEST(Config, SchemaDocumentIsUpToDate) {

@@ -25,8 +25,22 @@ const char* to_string(ValueType type) {
   return "?";
 }
 
+namespace {
+// A config repeating a mistake thousands of times gets the first ones and a note: its
+// report stays readable and its memory bounded.
+constexpr std::size_t kMaxErrorsShown = 100;
+// Configs and layouts are a few kB; a bigger "config" is something else (a FIFO fed
+// forever, a log), and reading it whole would take the daemon's memory.
+constexpr std::size_t kMaxConfigBytes = 4 << 20;
+}  // namespace
+
 void ConfigErrors::add(const std::string& file, const toml::source_region& where,
                        const std::string& key_path, const std::string& message) {
+  if (errors_.size() >= kMaxErrorsShown) {
+    if (errors_.size() == kMaxErrorsShown)
+      errors_.push_back(fmt::format("(only the first {} problems are shown)", kMaxErrorsShown));
+    return;
+  }
   errors_.push_back(fmt::format("{}:{}:{}: {}: {}", file, where.begin.line, where.begin.column,
                                 key_path, message));
 }
@@ -43,8 +57,13 @@ void ConfigErrors::add_resource_check(const std::string& file, const toml::sourc
 }
 
 void ConfigErrors::run_resource_checks() {
-  for (const PendingCheck& c : checks_)
-    if (auto ok = c.check(); !ok) add(c.file, c.where, c.key_path, ok.error().message);
+  for (const PendingCheck& c : checks_) {
+    try {  // a check that throws is a failed check at its key, not the end of --check
+      if (auto ok = c.check(); !ok) add(c.file, c.where, c.key_path, ok.error().message);
+    } catch (const std::exception& e) {
+      add(c.file, c.where, c.key_path, fmt::format("cannot be checked: {}", e.what()));
+    }
+  }
   checks_.clear();
 }
 
@@ -260,9 +279,12 @@ Result<std::string> read_config_text(const std::string& path) {
     return fail(fmt::format("{}: is {}, not a file to read", path, describe(kind)));
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(path + ": cannot read the file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  std::string text(kMaxConfigBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxConfigBytes)
+    return fail(fmt::format("{}: is larger than {} MiB, too large for a config file", path, kMaxConfigBytes >> 20));
+  return text;
 }
 
 Result<toml::table> parse_toml(std::string_view text, const std::string& source_name) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -152,6 +153,10 @@ Serial6dofConfig read_serial6dof_config(TableReader& r, const std::string& devic
 
   std::optional<Mat6> device_cov;
   if (has_covariance(r)) device_cov = read_covariance(r);
+  // One error per repeated station, not one per pair: a config repeating a station
+  // thousands of times is reported in linear time and memory.
+  std::set<int> numbers;
+  std::set<std::string> names;
   for (const toml::table* t : r.tables("stations")) {
     const std::string path = r.path("stations") + fmt::format("[{}]", c.stations.size());
     TableReader s(*t, path, serial6dof_station_spec(protocol), r.file(), r.errors());
@@ -162,10 +167,8 @@ Serial6dofConfig read_serial6dof_config(TableReader& r, const std::string& devic
       s.error("name", fmt::format("'{}' is not a valid sensor name (1-{} of A-Z a-z 0-9 _ -)",
                                   st.name, kMaxNameLength));
     st.covariance = has_covariance(s) ? std::optional<Mat6>(read_covariance(s)) : device_cov;
-    for (const auto& other : c.stations) {
-      if (other.number == st.number) s.error("number", fmt::format("station {} is listed twice", st.number));
-      if (other.name == st.name) s.error("name", fmt::format("sensor name '{}' is used twice", st.name));
-    }
+    if (!numbers.insert(st.number).second) s.error("number", fmt::format("station {} is listed twice", st.number));
+    if (!names.insert(st.name).second) s.error("name", fmt::format("sensor name '{}' is used twice", st.name));
     c.stations.push_back(st);
   }
   if (c.stations.empty()) c.stations.push_back({1, "st1", device_cov});

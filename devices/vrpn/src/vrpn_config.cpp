@@ -1,3 +1,6 @@
+#include <set>
+#include <string>
+
 #include <fmt/format.h>
 
 #include "covtrack/devices/covariance_keys.hpp"
@@ -64,6 +67,8 @@ VrpnConfig read_vrpn_config(TableReader& r, const std::string& device_name) {
     else r.error("tracker", address.error().message);
   }
   if (has_covariance(r)) c.covariance = read_covariance(r);
+  std::set<int> numbers;  // one error per repeated sensor, not one per pair
+  std::set<std::string> names;
   for (const toml::table* t : r.tables("sensors")) {
     TableReader s(*t, r.path("sensors") + fmt::format("[{}]", c.sensors.size()), vrpn_sensor_spec(), r.file(),
                   r.errors());
@@ -76,10 +81,9 @@ VrpnConfig read_vrpn_config(TableReader& r, const std::string& device_name) {
     if (has_covariance(s)) sensor.covariance = read_covariance(s);
     else if (c.covariance) sensor.covariance = *c.covariance;
     else s.error("number", "no covariance: give sigma_m and sigma_rad (or covariance) here or for the device");
-    for (const auto& other : c.sensors) {
-      if (other.number == sensor.number) s.error("number", fmt::format("sensor {} is listed twice", sensor.number));
-      if (other.name == sensor.name) s.error("name", fmt::format("sensor name '{}' is used twice", sensor.name));
-    }
+    if (!numbers.insert(sensor.number).second)
+      s.error("number", fmt::format("sensor {} is listed twice", sensor.number));
+    if (!names.insert(sensor.name).second) s.error("name", fmt::format("sensor name '{}' is used twice", sensor.name));
     c.sensors.push_back(sensor);
   }
   if (c.sensors.empty() && !c.covariance)
