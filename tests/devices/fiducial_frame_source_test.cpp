@@ -170,13 +170,24 @@ TEST(FrameSource, ASourceThatCannotOpenSaysWhatAndWhere) {
   const std::string bad_pattern = (dir / "frame_%s.png").string();
   EXPECT_NE(error_of(bad_pattern).find("must hold exactly one %d field"), std::string::npos);
 
-  // The config check opens a camera's device node only; a missing one is named.
+  // For a camera, the check opens its device node only; a missing one is named. (covtrackd
+  // --check does not call it for a camera: a config for hardware checks without it.)
   auto camera = check_frame_source("63");
   ASSERT_FALSE(camera.has_value());
   EXPECT_NE(camera.error().message.find("cannot open camera 63: /dev/video63: No such file or directory"),
             std::string::npos)
       << camera.error().message;
   EXPECT_TRUE(check_frame_source(write_sequence("present", ".png", 1).string()).has_value());
+}
+
+// A width too long for an int (found by mutation fuzzing: std::stoi threw, which ended
+// `covtrackd --check`) is taken as 32, as every width over 32 is.
+TEST(FrameSource, AFieldWidthTooLongForAnIntIsTakenAs32) {
+  const fs::path dir = fresh_dir("width");
+  const std::string source = (dir / "frame_%099999999999d.png").string();
+  const std::string first = (dir / ("frame_" + std::string(32, '0') + ".png")).string();
+  const std::string second = (dir / ("frame_" + std::string(31, '0') + "1.png")).string();
+  EXPECT_EQ(error_of(source), fmt::format("image sequence '{}': neither '{}' nor '{}' exists", source, first, second));
 }
 
 // Nobody writes to these FIFOs: if a source opened one, this test would hang, not fail.

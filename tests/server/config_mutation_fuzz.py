@@ -6,7 +6,8 @@ deterministically from --seed: numbers to huge, negative, zero, NaN, inf; string
 empty, long, odd paths and format directives; arrays emptied or made huge; lines and
 [[table]] blocks dropped or repeated; bits flipped. Every mutant runs as
 `covtrackd --config MUTANT` inside a private network namespace (tests/netns_run.sh:
-the daemon publishes multicast) for --seconds, then gets SIGTERM. Outcomes:
+the daemon publishes multicast) for --seconds, then gets SIGTERM; then, if that went
+well, `covtrackd --check --config MUTANT` runs. Outcomes:
 
   good  config-error    exit 2 with "the config has errors" (a clear error at load)
   good  ran             still running at the deadline, stopped on SIGTERM with 0
@@ -14,7 +15,10 @@ the daemon publishes multicast) for --seconds, then gets SIGTERM. Outcomes:
   bad   sanitizer       AddressSanitizer / UndefinedBehaviorSanitizer / LeakSanitizer report
   bad   memory          out of memory (ulimit -v, or ASan's hard RSS limit)
   bad   crash           ended by a signal (an uncaught exception aborts) or with another code
+  bad   slow-load       still reading the config at the deadline (ended by the SIGTERM, as documented)
   bad   stuck-stop      did not stop within --stop-grace seconds of SIGTERM, or code 4
+  bad   check-failed    the run was good, but `covtrackd --check` of the mutant crashed, hung or
+                        reported a sanitizer error (it must exit 0, or 2 with the config's errors)
 
 Serial ports in the configs are first pointed into the scratch folder (no file there:
 the drivers retry), so no mutant opens a device of this machine or another test's
@@ -283,6 +287,8 @@ def classify(code, early, stderr, stopped_in_time):
         return "crash"
     if code == 0:
         return "ran"
+    if code == -signal.SIGTERM:  # still reading the config: it ends by the signal, as documented
+        return "slow-load"
     if code == 4:
         return "stuck-stop"
     return "crash"
@@ -351,6 +357,22 @@ class Runner:
         if code < 0 and early:
             stderr += f"\n(ended by signal {signal.Signals(-code).name})"
         return classify(code, early, stderr, stopped), code, elapsed, stderr
+
+    def check(self, folder, config):
+        """`covtrackd --check` of the mutant: exit 0 or a clear config error, nothing else."""
+        try:
+            done = subprocess.run([self.args.daemon, "--check", "--config", config], cwd=folder, text=True,
+                                  errors="replace", capture_output=True, env=self.env(folder),
+                                  preexec_fn=self.limit_memory, timeout=self.args.stop_grace)
+        except subprocess.TimeoutExpired:
+            return "check-failed", None, f"--check still running after {self.args.stop_grace} s"
+        out = done.stdout + done.stderr
+        clean = done.returncode == 0 or (done.returncode == 2 and "the config has errors" in out)
+        if clean and not SANITIZER.search(out):
+            return None, done.returncode, out
+        if done.returncode < 0:
+            out += f"\n(ended by signal {signal.Signals(-done.returncode).name})"
+        return "check-failed", done.returncode, out
 
 
 # ---------------------------------------------------------------------------- the bases
@@ -431,6 +453,10 @@ def main():
         files = dict(shipped, **{name: mutant})
         config = prepare(folder, source, frames_root, host, files)
         outcome, code, elapsed, stderr = runner.run(folder, config)
+        if outcome in GOOD:  # the run was fine: then --check must be too
+            failed, check_code, check_out = runner.check(folder, config)
+            if failed:
+                outcome, code, stderr = failed, check_code, check_out
         if outcome in GOOD and not args.keep_all:
             shutil.rmtree(folder, ignore_errors=True)
         return name, index, how, outcome, code, elapsed, stderr, folder
@@ -454,7 +480,7 @@ def main():
             elif outcome == "runtime-exit" or args.only:
                 print(f"{name}:{index} {outcome} (code {code}; {how}): {headline(stderr)}", flush=True)
 
-    outcomes = list(GOOD) + ["sanitizer", "memory", "crash", "stuck-stop"]
+    outcomes = list(GOOD) + ["sanitizer", "memory", "crash", "slow-load", "stuck-stop", "check-failed"]
     print("\n| config | " + " | ".join(outcomes) + " |")
     print("|---|" + "---|" * len(outcomes))
     total = collections.Counter()

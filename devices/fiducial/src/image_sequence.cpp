@@ -82,7 +82,9 @@ Result<FilePattern> parse_pattern(const std::string& source) {
   if (i < source.size() && source[i] == '0') p.zero_pad = true, ++i;
   const std::size_t digits = i;
   while (i < source.size() && std::isdigit(static_cast<unsigned char>(source[i]))) ++i;
-  if (i > digits) p.width = std::min(std::stoi(source.substr(digits, i - digits)), 32);
+  // Widths over 32 are taken as 32; one too long for an int is too (std::stoi threw on it,
+  // which ended `covtrackd --check`).
+  if (i > digits) p.width = i - digits > 2 ? 32 : std::min(std::stoi(source.substr(digits, i - digits)), 32);
   if (i >= source.size() || source[i] != 'd' || source.find('%', i) != std::string::npos)
     return fail(fmt::format("image sequence '{}': the pattern must hold exactly one %d field, "
                             "e.g. frame_%04d.png", source));

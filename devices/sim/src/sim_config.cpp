@@ -1,5 +1,7 @@
 #include "covtrack/devices/sim/sim_config.hpp"
 
+#include <set>
+
 #include <fmt/format.h>
 
 #include "covtrack/devices/covariance_keys.hpp"
@@ -7,13 +9,16 @@
 #include "covtrack/protocol/channels.hpp"
 
 namespace covtrack::sim {
+namespace {
+constexpr int kMaxSimSensors = 64;
+}  // namespace
 
 const TableSpec& sim_device_spec() {
   static const TableSpec spec = [] {
     TableSpec s{"devices.<name> (type = \"sim\")", "sim driver", device_common_keys()};
     const std::vector<KeySpec> own = {
         {"sensors", ValueType::StringArray, "", "", "sensor names (child frames); or sensor_count"},
-        {"sensor_count", ValueType::Integer, "", "", "N sensors named s0..s(N-1); or sensors", 1, 64},
+        {"sensor_count", ValueType::Integer, "", "", "N sensors named s0..s(N-1); or sensors", 1, kMaxSimSensors},
         {"rate_hz", ValueType::Float, "Hz", "100", "reports per second per sensor", 0.01, 10000},
         {"seed", ValueType::Integer, "", "1", "noise seed: same seed, same noise", 0, 4e18},
         {"dropout_every_s", ValueType::Float, "s", "0", "a LOST interval ends every this many "
@@ -98,10 +103,18 @@ SimConfig read_sim_config(TableReader& r, const std::string& device_name) {
   } else if (r.has("sensors")) {
     c.sensors = r.strings("sensors");
     if (c.sensors.empty()) r.error("sensors", "needs at least one sensor name");
-    for (const auto& s : c.sensors)
+    // As many as sensor_count allows: 100,000 names made a device that could not keep
+    // its rate and did not stop within daemon.stop_timeout_s.
+    if (c.sensors.size() > static_cast<std::size_t>(kMaxSimSensors))
+      r.error("sensors", fmt::format("{} sensors: at most {}", c.sensors.size(), kMaxSimSensors));
+    std::set<std::string> names;
+    for (const auto& s : c.sensors) {
       if (!is_valid_name(s))
         r.error("sensors", fmt::format("'{}' is not a valid sensor name (1-{} of A-Z a-z 0-9 _ -)",
                                        s, kMaxNameLength));
+      else if (!names.insert(s).second)
+        r.error("sensors", fmt::format("'{}' is listed twice", s));
+    }
   } else {
     const auto n = r.integer("sensor_count", 1);
     for (std::int64_t i = 0; i < n; ++i) c.sensors.push_back(fmt::format("s{}", i));
