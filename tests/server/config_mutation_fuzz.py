@@ -128,6 +128,12 @@ def quote(s):
 
 # ---------------------------------------------------------------------------- mutators
 
+def pick(lines, rng, kind=None):
+    """A random line holding a value of `kind` (any when None), or None if there is none."""
+    candidates = value_lines(lines, kind)
+    return rng.choice(candidates) if candidates else None
+
+
 def mutate_number(lines, rng):
     candidates = value_lines(lines, "number")
     arrays = [i for i in value_lines(lines, "array") if re.search(r"[-+0-9.]", get_value(lines, i))]
@@ -144,36 +150,34 @@ def mutate_number(lines, rng):
 
 
 def mutate_string(lines, rng):
-    candidates = value_lines(lines, "string")
-    if not candidates:
+    i = pick(lines, rng, "string")
+    if i is None:
         return False
-    set_value(lines, rng.choice(candidates), quote(rng.choice(odd_strings())))
+    set_value(lines, i, quote(rng.choice(odd_strings())))
     return True
 
 
 def mutate_type(lines, rng):
-    candidates = value_lines(lines)
-    if not candidates:
+    i = pick(lines, rng)
+    if i is None:
         return False
-    set_value(lines, rng.choice(candidates), rng.choice(['"12"', "12", "true", "[]", "{}", "[[1, 2], [3]]",
+    set_value(lines, i, rng.choice(['"12"', "12", "true", "[]", "{}", "[[1, 2], [3]]",
                                                        '["a", 1]', "1979-05-27T07:32:00Z"]))
     return True
 
 
 def mutate_bool(lines, rng):
-    candidates = value_lines(lines, "bool")
-    if not candidates:
+    i = pick(lines, rng, "bool")
+    if i is None:
         return False
-    i = rng.choice(candidates)
     set_value(lines, i, "false" if get_value(lines, i) == "true" else "true")
     return True
 
 
 def mutate_array(lines, rng):
-    candidates = value_lines(lines, "array")
-    if not candidates:
+    i = pick(lines, rng, "array")
+    if i is None:
         return False
-    i = rng.choice(candidates)
     items = [s.strip() for s in get_value(lines, i)[1:-1].split(",") if s.strip()]
     item = items[0] if items else "1"
     choice = rng.randrange(4)
@@ -199,10 +203,9 @@ def drop_line(lines, rng):
 
 
 def duplicate_line(lines, rng):
-    candidates = value_lines(lines)
-    if not candidates:
+    i = pick(lines, rng)
+    if i is None:
         return False
-    i = rng.choice(candidates)
     lines.insert(i + 1, lines[i])
     return True
 
