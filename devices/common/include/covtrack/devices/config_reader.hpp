@@ -37,9 +37,9 @@ struct TableSpec {
   std::vector<KeySpec> keys;
 };
 
-// A check of something a config value names outside the config (a file, a folder, a
-// device node). Only `covtrackd --check` runs these: at start a device that is missing
-// may appear later, and its driver retries it with back-off, so it is no config error.
+// A check of something a config value names outside the config (a file, a folder; never
+// a device, which may be plugged in later). Only `covtrackd --check` runs these: at start
+// a file that is missing may appear later, and its driver retries it with back-off.
 using ResourceCheck = std::function<Result<void>()>;
 
 class ConfigErrors {
