@@ -282,9 +282,9 @@ def classify(code, early, stderr, stopped_in_time):
         return "memory"
     if not stopped_in_time:
         return "stuck-stop"
+    if code == 2 and "the config has errors" in stderr:  # early, or just as the deadline came
+        return "config-error"
     if early:
-        if code == 2 and "the config has errors" in stderr:
-            return "config-error"
         if code == 1 and stderr.strip():
             return "runtime-exit"
         return "crash"
