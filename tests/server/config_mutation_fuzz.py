@@ -420,7 +420,8 @@ def main():
                    "(the build's; default: SOURCE/build)")
     p.add_argument("--count", type=int, default=20, help="mutants per config")
     p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--seconds", type=float, default=4.0, help="run time of each mutant before SIGTERM")
+    p.add_argument("--seconds", type=float, default=5.0, help="run time of each mutant before SIGTERM "
+                   "(a sanitizer build on a loaded machine reads a 500 kB mutant in 1.5-3.5 s)")
     p.add_argument("--stop-grace", type=float, default=15.0, help="wait for the stop after SIGTERM")
     p.add_argument("--memory-mb", type=int, default=2048, help="address space limit (ASan: RSS limit)")
     p.add_argument("--jobs", type=int, default=2)
