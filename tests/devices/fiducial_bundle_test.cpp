@@ -19,6 +19,7 @@
 #include <optional>
 #include <random>
 
+
 #include "covtrack/devices/fiducial/bundle_pose.hpp"
 #include "covtrack/devices/fiducial/corner_noise.hpp"
 #include "covtrack/devices/fiducial/tag_detector.hpp"
@@ -82,6 +83,7 @@ struct FrameResult {
   std::optional<Pose> best_tag;  // the most precise single tag's pose, mapped to the bundle
   Mat6 best_tag_covariance = Mat6::Zero();
   std::vector<BundleObservation> seen;  // the bundle's tags as posed on their own
+  std::vector<CornerNoise> noise;       // what the corner model said about each of them
 };
 
 // Renders bundles and poses them as the driver does (detection, corner model, tag poses,
@@ -125,6 +127,7 @@ class Renderer {
       auto pose = estimate_tag_pose(camera_, d.corners_px, tag->size_m, corner_noise);
       if (!pose) continue;  // a tag cut by the frame's edge is refused
       out.seen.push_back({*tag, *pose});
+      out.noise.push_back(corner_noise);
       // The best single tag: the smallest covariance of the pose it gives the bundle.
       const Mat6 A = se3_adjoint(tag->T_bundle_tag);
       const Mat6 C = A * pose->covariance * A.transpose();
@@ -310,4 +313,62 @@ TEST(FiducialBundle, ATagMovedOnTheBoardIsFoundLeftOutAndCovered) {
   EXPECT_GE(named, n * 9 / 10);
   EXPECT_GE(inside, n * 95 / 100);
   EXPECT_LT(inside_plain, n / 2) << "the moved tag must matter, or this test shows nothing";
+}
+
+// The corner residuals of the bundles' tags against their true corners, split by the
+// model's terms: each tag's 8 corner errors are exactly 4 edge offsets and 4 edge turns
+// (edge_line_modes is invertible); the offsets split into their mean (the tag's apparent
+// scale) and the rest (each edge's own placement). Each part's mean square is set against
+// the model's variance of that part (devices/fiducial/README.md, "Tag bundles"), and the
+// scale's correlation between tags of one frame is measured.
+TEST(FiducialBundle, ResidualsByTermOnHeldOutRenders) {
+  const CameraModel cam = test::camera(800, 600, 58);
+  struct Parts {
+    double observed[3] = {0, 0, 0}, modelled[3] = {0, 0, 0};  // scale, edge placement, turns
+    double scale_products = 0;  // over pairs of tags of one frame
+    int tags = 0, pairs = 0;
+  } parts[2];
+  for (const FrameResult& f : consistent_frames()) {
+    if (!f.bundle || f.seen.size() < 2) continue;
+    Parts& p = parts[f.tent];
+    std::vector<double> scale;
+    for (const BundleObservation& o : f.seen) {
+      const auto X = tag_corner_points(o.tag.size_m);
+      Eigen::Matrix<double, 8, 1> d;
+      for (int k = 0; k < 4; ++k) {
+        const cv::Point2d t = cam.project(f.truth * (o.tag.T_bundle_tag * X[k]));
+        d(2 * k) = o.pose.corners_px[k].x - t.x, d(2 * k + 1) = o.pose.corners_px[k].y - t.y;
+      }
+      const Eigen::Matrix<double, 8, 8> to_modes = edge_line_modes(o.pose.corners_px).inverse();
+      const Eigen::Matrix<double, 8, 1> q = to_modes * d;
+      const Eigen::Matrix<double, 8, 8> C = to_modes * o.pose.corner_covariance * to_modes.transpose();
+      const Eigen::Matrix4d rest = Eigen::Matrix4d::Identity() - Eigen::Matrix4d::Constant(0.25);
+      const Eigen::Matrix4d offsets = C.topLeftCorner<4, 4>();
+      const double s = q.head<4>().mean();
+      p.observed[0] += s * s, p.modelled[0] += offsets.sum() / 16;
+      p.observed[1] += (rest * q.head<4>()).squaredNorm(), p.modelled[1] += (rest * offsets * rest).trace();
+      p.observed[2] += q.tail<4>().squaredNorm(), p.modelled[2] += C.bottomRightCorner<4, 4>().trace();
+      scale.push_back(s);
+      ++p.tags;
+    }
+    for (std::size_t i = 0; i < scale.size(); ++i)
+      for (std::size_t j = i + 1; j < scale.size(); ++j)
+        p.scale_products += scale[i] * scale[j], ++p.pairs;
+  }
+  for (int tent = 0; tent < 2; ++tent) {
+    const Parts& p = parts[tent];
+    const double corr = (p.scale_products / p.pairs) / (p.observed[0] / p.tags);
+    std::printf("%s tags (%d): observed / modelled mean square: apparent scale %.4f / %.4f px^2 (%.2f), edge placement "
+                "%.4f / %.4f (%.2f), edge turns %.4f / %.4f (%.2f); scale correlation between tags of a frame %.2f\n",
+                tent ? "tent" : "board", p.tags, p.observed[0] / p.tags, p.modelled[0] / p.tags,
+                p.observed[0] / p.modelled[0], p.observed[1] / p.tags, p.modelled[1] / p.tags,
+                p.observed[1] / p.modelled[1], p.observed[2] / p.tags, p.modelled[2] / p.tags,
+                p.observed[2] / p.modelled[2], corr);
+    ASSERT_GT(p.tags, 100);
+    // Each part of the model within 2x of what these renders show.
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GT(p.observed[k] / p.modelled[k], 0.5) << (tent ? "tent" : "board") << " part " << k;
+      EXPECT_LT(p.observed[k] / p.modelled[k], 2.0) << (tent ? "tent" : "board") << " part " << k;
+    }
+  }
 }

@@ -31,7 +31,7 @@ struct Residual {
   Vec8 bias_direction;    // M 1: the corners' motion when all four edges move out by 1 px
   // The shapes of the edge, scale and turn terms: M M^T, (M 1)(M 1)^T, N N^T.
   Mat8 edge_shape, scale_shape, tilt_shape;
-  Vec8 independent_var;   // the starting model's, per coordinate: image noise and floor
+  Mat8 independent;       // the starting model's edge-fit noise (image noise and floor)
   Vec8 shift_var;         //   and what its white-cell shift correction misses
   double scale_sd = 0, edge_sd = 0, tilt_sd = 0;  // the starting model's, at this blur
   double polarity_blur = 0;
@@ -53,7 +53,8 @@ Mat8 covariance_of(const Residual& v, const Params& p) {
   const double kI = std::exp(p[1]), kS = std::exp(p[2]), kE = std::exp(p[3]);
   const double e2 = std::pow(kE * v.edge_sd, 2), s2 = std::pow(kS * v.scale_sd, 2), t2 = std::pow(v.tilt_sd, 2);
   Mat8 S = e2 * v.edge_shape + s2 * v.scale_shape + t2 * v.tilt_shape + v.prediction;
-  S.diagonal() += kI * kI * v.independent_var + v.shift_var;
+  S += kI * kI * v.independent;
+  S.diagonal() += v.shift_var;
   return S;
 }
 
@@ -191,10 +192,10 @@ std::vector<Residual> residuals_of(const CameraModel& camera, const TagBundle& b
         v.r(2 * k) = unbiased_pose->corners_px[k].x - p.x;
         v.r(2 * k + 1) = unbiased_pose->corners_px[k].y - p.y;
         J.block<2, 6>(2 * k, 0) = point_jacobian(camera, placed->T_camera_bundle, X_board);
-        v.independent_var(2 * k) = v.independent_var(2 * k + 1) = noise.sigma_px * noise.sigma_px;
         v.shift_var(2 * k) = v.shift_var(2 * k + 1) = noise.extra_px[k] * noise.extra_px[k];
       }
       const Mat8 modes = edge_line_modes(unbiased_pose->corners_px);
+      v.independent = noise.sigma_px * noise.sigma_px * edge_fit_noise_shape(unbiased_pose->corners_px);
       const Mat84 out_modes = modes.leftCols<4>(), turn_modes = modes.rightCols<4>();
       v.bias_direction = out_modes * Eigen::Vector4d::Ones();
       v.edge_shape = out_modes * out_modes.transpose();
