@@ -178,7 +178,8 @@ std::pair<double, double> mean_bounds(int n) {
 
 }  // namespace
 
-// Catches a wrong Jacobian, a wrong adjoint, or blocks treated as anything but independent.
+// Catches a wrong Jacobian, a wrong adjoint, or tags' corners correlated other than by the
+// apparent-scale error they share.
 TEST(FiducialBundle, CovarianceIsExactForCornersDrawnFromTheModel) {
   constexpr double kChi2_6_999 = 22.458;
   const CameraModel cam = test::camera(800, 600, 58);
@@ -194,14 +195,19 @@ TEST(FiducialBundle, CovarianceIsExactForCornersDrawnFromTheModel) {
     const auto layout = draw % 2 ? tent(**family) : board(**family);
     const Pose T_camera_bundle = random_bundle_pose(rng);
     std::vector<BundleObservation> seen;
+    // One apparent-scale error for the whole frame, shared by its tags; the rest per tag.
+    const double shared_scale = gauss(rng);
+    CornerNoise own = noise;
+    own.scale_sigma_px = 0;
     for (const BundleTag& t : layout) {
       const auto X = tag_corner_points(t.size_m);
       std::array<cv::Point2d, 4> corners;
       for (int k = 0; k < 4; ++k) corners[k] = cam.project(T_camera_bundle * t.T_bundle_tag * X[k]);
-      const Eigen::Matrix<double, 8, 8> L = corner_covariance(corners, noise).llt().matrixL();
+      const Eigen::Matrix<double, 8, 8> L = corner_covariance(corners, own).llt().matrixL();
       Eigen::Matrix<double, 8, 1> z;
       for (int i = 0; i < 8; ++i) z(i) = gauss(rng);
-      const Eigen::Matrix<double, 8, 1> e = L * z;
+      const Eigen::Matrix<double, 8, 1> e =
+          L * z + shared_scale * noise.scale_sigma_px * edge_line_modes(corners).leftCols<4>().rowwise().sum();
       for (int k = 0; k < 4; ++k) corners[k] += cv::Point2d(e(2 * k), e(2 * k + 1));
       auto pose = estimate_tag_pose(cam, corners, t.size_m, noise);
       if (pose) seen.push_back({t, *pose});  // else too near the frame's edge
@@ -350,6 +356,29 @@ TEST(FiducialBundle, ResidualsByTermOnHeldOutRenders) {
       p.observed[2] += q.tail<4>().squaredNorm(), p.modelled[2] += C.bottomRightCorner<4, 4>().trace();
       scale.push_back(s);
       ++p.tags;
+      {  // TEMP split by term
+        static double acc[2][5][2];
+        const CornerNoise& nz = f.noise[scale.size() - 1];
+        for (int term = 0; term < 5; ++term) {
+          CornerNoise only{}; only.sigma_px = 1e-12;
+          if (term == 0) only.sigma_px = nz.sigma_px;
+          if (term == 1) only.extra_px = nz.extra_px;
+          if (term == 2) only.edge_sigma_px = nz.edge_sigma_px;
+          if (term == 3) only.scale_sigma_px = nz.scale_sigma_px;
+          if (term == 4) only.tilt_sigma_px = nz.tilt_sigma_px;
+          const Eigen::Matrix<double, 8, 8> Ct = to_modes * corner_covariance(o.pose.corners_px, only) * to_modes.transpose();
+          const Eigen::Matrix4d ot = Ct.topLeftCorner<4, 4>();
+          acc[f.tent][term][0] += (rest * ot * rest).trace(), acc[f.tent][term][1] += Ct.bottomRightCorner<4, 4>().trace();
+        }
+        if (&f == &consistent_frames().back() && &o == &f.seen.back())
+          for (int t = 0; t < 2; ++t) {
+            std::printf("TEMP %s placement by term (sigma extra edge scale tilt):", t ? "tent" : "board");
+            for (int term = 0; term < 5; ++term) std::printf(" %.5f", acc[t][term][0] / parts[t].tags);
+            std::printf("  turns:");
+            for (int term = 0; term < 5; ++term) std::printf(" %.5f", acc[t][term][1] / parts[t].tags);
+            std::printf("\n");
+          }
+      }
     }
     for (std::size_t i = 0; i < scale.size(); ++i)
       for (std::size_t j = i + 1; j < scale.size(); ++j)

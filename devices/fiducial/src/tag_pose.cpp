@@ -218,6 +218,7 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
   out.corner_sigma_px = sigma;
   out.corners_px = {image[0], image[1], image[2], image[3]};
   out.corner_covariance = corner_cov;
+  out.scale_mode_px = noise.scale_sigma_px * edge_line_modes(out.corners_px).leftCols<4>().rowwise().sum();
   out.covariance = pose_covariance(corner_jacobian(cam, out.best.T_camera_tag, size_m), corner_cov);
   out.ambiguity_chi2 = std::numeric_limits<double>::infinity();
   if (solutions.size() > 1) {

@@ -48,6 +48,10 @@ struct TagPose {
   // stacks these of its tags).
   std::array<cv::Point2d, 4> corners_px{};
   Eigen::Matrix<double, 8, 8> corner_covariance = Eigen::Matrix<double, 8, 8>::Zero();
+  // Its apparent-scale term: how the corners move for a one-sigma error of the four edges'
+  // common outward placement (scale_sigma M 1; part of corner_covariance). The tags of one
+  // frame share it: a bundle correlates their corners through it.
+  Eigen::Matrix<double, 8, 1> scale_mode_px = Eigen::Matrix<double, 8, 1>::Zero();
 };
 
 // The tag's corners in its own frame, in the detector's order (AprilTag 3's).
