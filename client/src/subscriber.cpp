@@ -12,6 +12,7 @@
 #include "covtrack/client/pose_validation.hpp"
 #include "covtrack/client/sequence_tracker.hpp"
 #include "covtrack/protocol/channel_messages.hpp"
+#include "covtrack/protocol/channel_pattern.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 
@@ -23,15 +24,6 @@ constexpr int kStaleCheckMs = 20;
 constexpr std::int64_t kDrainUs = 200'000;
 // Heartbeats come once per second per device; this only absorbs a burst at start-up.
 constexpr int kStatusQueueCapacity = 1000;
-
-// POSIX extended syntax: the same dialect LCM's own channel regex (regcomp) uses.
-Result<std::regex> compile(const std::string& pattern) {
-  try {
-    return std::regex(pattern, std::regex::extended | std::regex::optimize);
-  } catch (const std::regex_error& e) {
-    return fail("bad stream pattern '" + pattern + "': " + e.what());
-  }
-}
 
 struct Callback {
   std::regex pattern;
@@ -215,7 +207,7 @@ Subscriber::Subscriber(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Subscriber::~Subscriber() { stop(); }
 
 Result<std::unique_ptr<Subscriber>> Subscriber::open(const SubscriberOptions& options) {
-  if (auto re = compile(options.pattern); !re) return std::unexpected(re.error());
+  if (auto re = compile_channel_pattern(options.pattern); !re) return std::unexpected(re.error());
   auto lcm = open_lcm(options.lcm_url);
   if (!lcm) return std::unexpected(lcm.error());
   return attach(std::shared_ptr<lcm::LCM>(std::move(*lcm)), options);
@@ -223,7 +215,7 @@ Result<std::unique_ptr<Subscriber>> Subscriber::open(const SubscriberOptions& op
 
 Result<std::unique_ptr<Subscriber>> Subscriber::attach(std::shared_ptr<lcm::LCM> lcm,
                                                        const SubscriberOptions& options) {
-  if (auto re = compile(options.pattern); !re) return std::unexpected(re.error());
+  if (auto re = compile_channel_pattern(options.pattern); !re) return std::unexpected(re.error());
   if (!lcm || !lcm->good()) return fail("Subscriber::attach: the LCM instance is not usable");
   auto impl = std::make_unique<Impl>();
   impl->options = options;
@@ -244,7 +236,7 @@ Result<std::unique_ptr<Subscriber>> Subscriber::attach(std::shared_ptr<lcm::LCM>
 }
 
 Result<void> Subscriber::on_pose(const std::string& pattern, PoseCallback callback) {
-  auto re = compile(pattern);
+  auto re = compile_channel_pattern(pattern);
   if (!re) return std::unexpected(re.error());
   std::lock_guard lock(impl_->callbacks_mutex);
   auto next = std::make_shared<CallbackList>(*impl_->callbacks);

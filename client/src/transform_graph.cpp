@@ -5,6 +5,7 @@
 
 #include "covtrack/client/graph_chain.hpp"
 #include "covtrack/client/graph_osgar_matrix16.hpp"
+#include "graph_fusion.hpp"
 
 namespace covtrack::client {
 
@@ -51,6 +52,10 @@ std::vector<TransformGraph::FrameIndex> TransformGraph::ancestry(FrameIndex fram
 
 Result<void> TransformGraph::add_edge(const std::string& parent, const std::string& child, Edge edge) {
   std::lock_guard lock(mutex_);
+  return link(parent, child, std::move(edge));
+}
+
+Result<void> TransformGraph::link(const std::string& parent, const std::string& child, Edge edge) {
   if (parent.empty() || child.empty()) return fail("transform graph: empty frame name");
   if (parent == child) return fail("transform graph: edge " + parent + " -> " + child + " is a loop");
   const auto existing_child = find(child), existing_parent = find(parent);
@@ -76,19 +81,42 @@ Result<void> TransformGraph::add_edge(const std::string& parent, const std::stri
 
 Result<void> TransformGraph::add_static_edge(const std::string& parent, const std::string& child,
                                              const Pose& T_parent_child, const Mat6& covariance) {
-  return add_edge(parent, child, Edge{{StaticSource{T_parent_child, covariance}}, std::nullopt});
+  return add_edge(parent, child, Edge{{StaticSource{T_parent_child, covariance}}, std::nullopt, {}});
 }
 
 Result<void> TransformGraph::add_tracked_edge(const std::string& parent, const std::string& child,
                                               const StreamId& stream, const MotionBound& motion) {
-  return add_edge(parent, child, Edge{{TrackedSource{stream, motion}}, std::nullopt});
+  return add_edge(parent, child, Edge{{TrackedSource{stream, motion}}, std::nullopt, {}});
 }
 
 Result<void> TransformGraph::add_combined_edge(const std::string& parent, const std::string& child,
                                                std::vector<EdgeSource> sources, Combiner combiner) {
   if (sources.empty())
     return fail("transform graph: combined edge " + parent + " -> " + child + " has no source");
-  return add_edge(parent, child, Edge{std::move(sources), std::move(combiner)});
+  return add_edge(parent, child, Edge{std::move(sources), std::move(combiner), {}});
+}
+
+Result<void> TransformGraph::add_fused_frame(const std::string& parent, const std::string& child,
+                                             std::vector<std::string> via, std::optional<Combiner> combiner) {
+  std::lock_guard lock(mutex_);
+  const std::string what = "transform graph: fused frame '" + child + "'";
+  if (via.empty()) return fail(what + " names no path (via)");
+  const auto p = find(parent);
+  if (!p) return fail(what + ": unknown parent frame '" + parent + "'");
+  Edge edge;
+  for (const std::string& name : via) {
+    const auto v = find(name);
+    if (!v) return fail(what + ": unknown via frame '" + name + "'");
+    if (tree_of(*v) != tree_of(*p))
+      return fail(what + ": via frame '" + name + "' is not connected to parent '" + parent + "'");
+    if (std::find(edge.via.begin(), edge.via.end(), *v) != edge.via.end())
+      return fail(what + ": via frame '" + name + "' is named twice");
+    edge.via.push_back(*v);
+  }
+  // The via frames are in the parent's tree, so link()'s cycle check also keeps them out
+  // of the child's: a fused edge never depends on itself.
+  edge.combiner = std::move(combiner);
+  return link(parent, child, std::move(edge));
 }
 
 Result<void> TransformGraph::store_report(const StreamId& stream, const TrackedTransform& report) {
@@ -178,51 +206,155 @@ Result<UncertainPose> TransformGraph::query(const std::string& A, const std::str
   return r->pose;
 }
 
+// What one query has evaluated: each edge once, as a value and as a linear function of the
+// errors of the edges whose errors are their own (graph_fusion.hpp).
+struct TransformGraph::QueryState {
+  struct Evaluated {
+    UncertainPose value;
+    fusion::LinearEstimate linear;
+  };
+  std::int64_t now_us = 0;
+  std::unordered_map<FrameIndex, Evaluated> edges;
+  std::unordered_map<FrameIndex, Mat6> own_covariance;
+  std::vector<EdgeChoice> choices;
+
+  fusion::EdgeCovariance covariance_of() const {
+    return [this](fusion::EdgeKey e) -> const Mat6& { return own_covariance.at(e); };
+  }
+  // T_A_B along the path: the edges from A up, inverted, then down to B.
+  fusion::LinearEstimate along(const TreePath& path) const {
+    std::vector<fusion::LinearFactor> factors;
+    for (FrameIndex c : path.up_A) factors.push_back({&edges.at(c).linear, true});
+    for (auto it = path.up_B.rbegin(); it != path.up_B.rend(); ++it)
+      factors.push_back({&edges.at(*it).linear, false});
+    return fusion::compose(factors);
+  }
+};
+
+std::optional<TransformGraph::TreePath> TransformGraph::tree_path(FrameIndex A, FrameIndex B) const {
+  const auto up_A = ancestry(A);
+  const auto up_B = ancestry(B);
+  const std::unordered_set<FrameIndex> set_A(up_A.begin(), up_A.end());
+  const auto lca = std::find_if(up_B.begin(), up_B.end(), [&](FrameIndex f) { return set_A.contains(f); });
+  if (lca == up_B.end()) return std::nullopt;
+  return TreePath{{up_A.begin(), std::find(up_A.begin(), up_A.end(), *lca)}, {up_B.begin(), lca}};
+}
+
+Result<void> TransformGraph::evaluate_edge(FrameIndex child, QueryState& state) const {
+  if (state.edges.contains(child)) return {};
+  if (!frames_[child].edge.via.empty()) return evaluate_fused(child, state);
+  auto v = edge_value(child, state.now_us);
+  if (!v) return std::unexpected(v.error());
+  if (v->choice) state.choices.push_back(*v->choice);
+  state.own_covariance[child] = v->value.covariance;
+  state.edges[child] = {v->value, {v->value.T, {{child, Mat6::Identity()}}}};
+  return {};
+}
+
+Result<void> TransformGraph::evaluate_fused(FrameIndex child, QueryState& state) const {
+  const Frame& frame = frames_[child];
+  const std::vector<FrameIndex>& via = frame.edge.via;
+  std::vector<fusion::LinearEstimate> paths;
+  std::vector<UncertainPose> candidates;
+  for (FrameIndex v : via) {
+    const TreePath path = *tree_path(*frame.parent, v);  // one tree: checked when added
+    bool unbounded = false;
+    for (const auto* part : {&path.up_A, &path.up_B})
+      for (FrameIndex c : *part) {
+        if (auto r = evaluate_edge(c, state); !r) return r;
+        unbounded = unbounded || state.edges.at(c).value.unbounded;
+      }
+    paths.push_back(state.along(path));
+    candidates.push_back({paths.back().T, fusion::covariance(paths.back(), state.covariance_of()), unbounded});
+  }
+
+  QueryState::Evaluated out;
+  EdgeChoice choice{frame.name, 0, false};
+  if (frame.edge.combiner) {
+    auto combined = frame.edge.combiner->combine(candidates);
+    if (!combined) return fail("transform graph: fused frame '" + frame.name + "': " + combined.error().message);
+    choice = {frame.name, combined->chosen, combined->fused};
+    out.value = combined->pose;
+    if (!combined->fused) {
+      out.linear = paths[combined->chosen];
+    } else {  // its correlation with the other edges is unknown: its error is its own
+      state.own_covariance[child] = out.value.covariance;
+      out.linear = {out.value.T, {{child, Mat6::Identity()}}};
+    }
+  } else {
+    std::vector<fusion::LinearEstimate> bounded;
+    std::vector<std::size_t> index_of;
+    for (std::size_t k = 0; k < paths.size(); ++k)
+      if (!candidates[k].unbounded) {
+        bounded.push_back(std::move(paths[k]));
+        index_of.push_back(k);
+      }
+    if (bounded.empty()) {
+      out.value = {candidates.front().T, Mat6::Zero(), true};
+      out.linear = {candidates.front().T, {}};
+    } else {
+      std::size_t base = 0;
+      out.linear = fusion::fuse(bounded, state.covariance_of(), &base);
+      const Mat6 c = fusion::covariance(out.linear, state.covariance_of());
+      out.value = {out.linear.T, 0.5 * (c + c.transpose()), false};
+      choice = {frame.name, index_of[base], bounded.size() > 1};
+    }
+  }
+  state.choices.push_back(choice);
+  state.edges[child] = std::move(out);
+  return {};
+}
+
 Result<QueryResult> TransformGraph::query_detailed(const std::string& A, const std::string& B,
                                                    std::int64_t now_us, Propagation mode) const {
   std::lock_guard lock(mutex_);  // one lock for the whole query: consistent edges
   for (const auto* f : {&A, &B})
     if (!index_.contains(*f)) return fail("transform graph: unknown frame '" + *f + "'");
-  const auto up_A = ancestry(*find(A));
-  const auto up_B = ancestry(*find(B));
-  const std::unordered_set<FrameIndex> set_A(up_A.begin(), up_A.end());
-  const auto lca = std::find_if(up_B.begin(), up_B.end(), [&](FrameIndex f) { return set_A.contains(f); });
-  if (lca == up_B.end())
-    return fail("transform graph: frames '" + A + "' and '" + B + "' are in different trees");
-
-  // The edges each mode needs: the path through the LCA, or both whole root paths.
-  const bool from_root = mode != Propagation::LowestCommonAncestor;
-  const auto stop_A = from_root ? up_A.end() - 1 : std::find(up_A.begin(), up_A.end(), *lca);
-  const auto stop_B = from_root ? up_B.end() - 1 : lca;
-  const std::vector<FrameIndex> path_A(up_A.begin(), stop_A);  // child frames, A upwards
-  const std::vector<FrameIndex> path_B(up_B.begin(), stop_B);
+  const FrameIndex a = *find(A), b = *find(B);
+  auto path = tree_path(a, b);
+  if (!path) return fail("transform graph: frames '" + A + "' and '" + B + "' are in different trees");
+  if (mode != Propagation::LowestCommonAncestor) {  // both whole root paths
+    const auto up_A = ancestry(a), up_B = ancestry(b);
+    path = TreePath{{up_A.begin(), up_A.end() - 1}, {up_B.begin(), up_B.end() - 1}};
+  }
+  const std::vector<FrameIndex>& path_A = path->up_A;  // child frames, A upwards
+  const std::vector<FrameIndex>& path_B = path->up_B;
 
   QueryResult out;
-  std::unordered_map<FrameIndex, UncertainPose> values;  // each edge evaluated once per query
-  for (const auto* path : {&path_A, &path_B})
-    for (const auto& child : *path) {
-      if (values.contains(child)) continue;
-      auto v = edge_value(child, now_us);
-      if (!v) return std::unexpected(v.error());
-      if (v->choice) out.combiner_choices.push_back(*v->choice);
-      out.pose.unbounded = out.pose.unbounded || v->value.unbounded;
-      values[child] = v->value;
+  QueryState state;
+  state.now_us = now_us;
+  bool through_fused = false;
+  for (const auto* part : {&path_A, &path_B})
+    for (const auto& child : *part) {
+      if (auto r = evaluate_edge(child, state); !r) return std::unexpected(r.error());
+      out.pose.unbounded = out.pose.unbounded || state.edges.at(child).value.unbounded;
+      through_fused = through_fused || !frames_[child].edge.via.empty();
     }
+  out.combiner_choices = std::move(state.choices);
+  auto value = [&](FrameIndex c) -> const UncertainPose& { return state.edges.at(c).value; };
 
-  // Root-to-frame chains (top-down) for the root-based comparison modes.
+  // Root-to-frame chains (top-down) for the root-based comparison modes, which take every
+  // edge, fused ones too, as independent.
   auto root_chain = [&](const std::vector<FrameIndex>& path) {
     std::vector<ChainFactor> f;
     for (auto it = path.rbegin(); it != path.rend(); ++it)
-      f.push_back({values[*it].T, values[*it].covariance, false});
+      f.push_back({value(*it).T, value(*it).covariance, false});
     return f;
   };
 
   switch (mode) {
     case Propagation::LowestCommonAncestor: {
+      if (through_fused) {  // its paths may share edges with this one
+        const fusion::LinearEstimate l = state.along(*path);
+        const Mat6 c = fusion::covariance(l, state.covariance_of());
+        out.pose.T = l.T;
+        out.pose.covariance = 0.5 * (c + c.transpose());
+        break;
+      }
       std::vector<ChainFactor> factors;
-      for (const auto& c : path_A) factors.push_back({values[c].T, values[c].covariance, true});
+      for (const auto& c : path_A) factors.push_back({value(c).T, value(c).covariance, true});
       for (auto it = path_B.rbegin(); it != path_B.rend(); ++it)
-        factors.push_back({values[*it].T, values[*it].covariance, false});
+        factors.push_back({value(*it).T, value(*it).covariance, false});
       const UncertainPose p = compose_chain(factors);
       out.pose.T = p.T;
       out.pose.covariance = p.covariance;

@@ -1,12 +1,15 @@
 // Widget cost per frame against the regions they use: 100 objects, each region computed
 // (UT, the default) vs label placement for all of them vs selection (likelihoods by area
 // and by distance, direct selection, indirect targets). Single thread.
+// And the per-frame AR API (ar_view.hpp: graph queries, regions, Level of Error, labels)
+// for 1,000 objects against their regions alone.
 // Run: taskset -c 0 build/tests/client/bench_widgets ; ratios = widget time / regions time.
 #include <random>
 
 #include <benchmark/benchmark.h>
 
 #include "bench_frame.hpp"
+#include "covtrack/client/ar_view.hpp"
 #include "covtrack/client/label_placer.hpp"
 #include "covtrack/client/selection.hpp"
 
@@ -81,8 +84,49 @@ void BM_Selection100(benchmark::State& state) {
   state.counters["candidates"] = static_cast<double>(candidates);
 }
 
+// The same kind of objects, up to 1,000, each on its own edge from the camera.
+constexpr int kArObjects = 1000;
+const test::BenchFrame& ar_frame() {
+  static const test::BenchFrame f = test::make_bench_frame(kArObjects);
+  return f;
+}
+
+void BM_RegionsAlone(benchmark::State& state) {
+  const test::BenchFrame& f = ar_frame();
+  const int n = static_cast<int>(state.range(0));
+  ObjectRegions r;
+  for (auto _ : state)
+    for (int i = 0; i < n; ++i) {
+      compute_object_regions(f.camera, f.poses[i], f.vertices[i], {}, r);
+      benchmark::DoNotOptimize(r.outer.data());
+    }
+}
+
+void BM_ArView(benchmark::State& state) {
+  const test::BenchFrame& f = ar_frame();
+  TransformGraph graph;
+  std::vector<ArObject> objects;
+  for (int i = 0; i < state.range(0); ++i) {
+    const std::string name = "object" + std::to_string(i);
+    (void)graph.add_static_edge("camera", name, f.poses[i].T, f.poses[i].covariance);
+    objects.push_back({name, name, f.vertices[i], {20, 60}, 1, {false, false, true}});
+  }
+  ArViewOptions options;
+  options.labels.screen = kScreen;
+  auto view = ArView::create(f.camera, "camera", std::move(objects), std::move(options));
+  int listed = 0;
+  for (auto _ : state) {
+    (void)view->update(graph, 0);
+    benchmark::DoNotOptimize(view->frame().objects.data());
+  }
+  for (const ArObjectFrame& o : view->frame().objects) listed += o.label.placement == LabelPlacement::corner_list;
+  state.counters["listed"] = listed;
+}
+
 }  // namespace
 
+BENCHMARK(BM_RegionsAlone)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ArView)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Regions100)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_LabelPlacement100, fixed_order, fixed_order_policy(), true)
     ->Unit(benchmark::kMicrosecond);

@@ -2,6 +2,7 @@
 // recording and `covtrack view --log` find camera frames on.
 #include <gtest/gtest.h>
 
+#include "covtrack/protocol/channel_pattern.hpp"
 #include "covtrack/protocol/channels.hpp"
 
 using namespace covtrack;
@@ -24,4 +25,15 @@ TEST(Channels, LongestImageChannelFitsLcmsLimit) {
   const std::string longest_name(kMaxNameLength, 'd');
   ASSERT_TRUE(is_valid_name(longest_name));
   EXPECT_LE(image_channel(longest_name).size(), 63u);
+}
+
+TEST(ChannelPattern, IsPosixExtendedAndSaysWhatIsWrong) {
+  auto re = compile_channel_pattern("rig/(head|hand)[0-9]*");
+  ASSERT_TRUE(re) << re.error().message;
+  EXPECT_TRUE(std::regex_match("rig/hand12", *re));
+  EXPECT_FALSE(std::regex_match("rig/hand12x", *re));
+  const auto bad = compile_channel_pattern("rig/(?=head)");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("pattern 'rig/(?=head)' is not a POSIX extended regular expression"),
+            std::string::npos) << bad.error().message;
 }

@@ -183,7 +183,17 @@ TEST(ChannelFilterTest, MatchesWholeNamesLikeLcm) {
 TEST(ChannelFilterTest, InvalidRegexIsAnErrorNamingIt) {
   auto filter = ChannelFilter::create("covtrack/(pose");
   ASSERT_FALSE(filter);
-  EXPECT_NE(filter.error().message.find("covtrack/(pose"), std::string::npos);
+  EXPECT_NE(filter.error().message.find("pattern 'covtrack/(pose' is not a POSIX extended"), std::string::npos)
+      << filter.error().message;
+}
+
+TEST(ChannelFilterTest, SpeaksTheSubscribersDialect) {
+  // POSIX extended, as `covtrack echo` and LCM: alternation and classes, no Perl extras.
+  auto filter = ChannelFilter::create("covtrack/(pose|truth)/[a-z]+/head");
+  ASSERT_TRUE(filter);
+  EXPECT_TRUE(filter->matches("covtrack/truth/sim/head"));
+  EXPECT_FALSE(filter->matches("covtrack/raw/sim/head"));
+  EXPECT_FALSE(ChannelFilter::create("covtrack/(?=pose).*"));  // a lookahead is ECMAScript's
 }
 
 }  // namespace

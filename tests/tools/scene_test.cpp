@@ -51,6 +51,42 @@ TEST(Scene, MistakesGiveFileLineAndKeyPath) {
   expect_has(error_of("[camera\n"), "bad.toml:1:");
 }
 
+TEST(Scene, FusedFrameCombinesBothPathsOfTheTwoPathsExample) {
+  auto s = covtrack::scene::load_scene(COVTRACK_SOURCE_DIR "/config/scenes/two_paths.toml");
+  ASSERT_TRUE(s) << s.error().message;
+  ASSERT_EQ(s->fused.size(), 1u);
+  EXPECT_EQ(s->fused[0].via, (std::vector<std::string>{"toolbox_by_wand", "toolbox_by_marker"}));
+  covtrack::client::TransformGraph graph;
+  const std::int64_t now = 1'000'000;
+  ASSERT_TRUE(covtrack::scene::add_scene_transforms(*s, graph, now));
+  const auto fused = graph.query("camera", "toolbox", now);
+  const auto by_wand = graph.query("camera", "toolbox_by_wand", now);
+  const auto by_marker = graph.query("camera", "toolbox_by_marker", now);
+  ASSERT_TRUE(fused && by_wand && by_marker);
+  // The paths agree on the mean (the example is consistent), and together know more.
+  EXPECT_LT((fused->T.translation() - by_wand->T.translation()).norm(), 1e-9);
+  EXPECT_LT((fused->T.translation() - by_marker->T.translation()).norm(), 1e-9);
+  const auto position_trace = [](const covtrack::Mat6& c) { return c.topLeftCorner<3, 3>().trace(); };
+  EXPECT_LT(position_trace(fused->covariance), position_trace(by_wand->covariance));
+  EXPECT_LT(position_trace(fused->covariance), position_trace(by_marker->covariance));
+}
+
+TEST(Scene, FusedFrameMistakes) {
+  const std::string base = "[camera]\nframe = \"c\"\ncalibration = \"c.yml\"\n"
+                           "[[transform]]\nparent = \"w\"\nchild = \"a\"\nsigma_m = [1,1,1]\nsigma_rad = [1,1,1]\n";
+  expect_has(error_of(base + "[[fused]]\nframe = \"o\"\nparent = \"w\"\nvia = [\"a\"]\ncombiner = \"average\"\n"),
+             "bad.toml:13:12: fused[0].combiner:");
+  expect_has(error_of(base + "[[fused]]\nframe = \"o\"\nparent = \"w\"\nvia = []\n"), "fused[0].via: names no frame");
+  expect_has(error_of(base + "[[fused]]\nframe = \"o\"\nparent = \"w\"\n"), "fused[0].via:");
+  // Frames are checked when the graph is built: the message names the fused frame.
+  auto s = parse_scene(base + "[[fused]]\nframe = \"o\"\nparent = \"w\"\nvia = [\"a\", \"b\"]\n", "ok.toml", ".");
+  ASSERT_TRUE(s) << s.error().message;
+  covtrack::client::TransformGraph graph;
+  const auto r = covtrack::scene::add_scene_transforms(*s, graph, std::nullopt);
+  ASSERT_FALSE(r);
+  expect_has(r.error().message, "fused w -> o: transform graph: fused frame 'o': unknown via frame 'b'");
+}
+
 TEST(Scene, SchemaDocumentIsUpToDate) {
   std::ifstream in(COVTRACK_SOURCE_DIR "/config/scene_schema.md");
   std::stringstream text;

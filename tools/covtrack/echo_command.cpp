@@ -211,7 +211,7 @@ void add_echo_command(CLI::App& app) {
   auto o = std::make_shared<EchoOptions>();
   auto* cmd = app.add_subcommand("echo", "show pose streams live (table, or JSON per message)");
   cmd->add_option("pattern", o->subscriber.pattern,
-                  "regular expression over device/sensor, whole match (default: all)");
+                  "POSIX extended regular expression over device/sensor, whole match (default: all)");
   cmd->add_flag("--json,-j", o->json, "one JSON object per message, one per line");
   cmd->add_option("--lcm-url,-u", o->subscriber.lcm_url, "LCM URL");
   cmd->add_option("--stale", o->subscriber.stale_after_s, "seconds without a message before a stream is stale")

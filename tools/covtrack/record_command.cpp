@@ -96,7 +96,7 @@ void add_record_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("record", "Record LCM traffic into an LCM log file");
   cmd->add_option("FILE", args->path, "Log file to write (standard LCM log format)")->required();
   cmd->add_option("--channels", args->channels,
-                  "Regular expression matching whole channel names")
+                  "POSIX extended regular expression over whole channel names (covtrack/pose/.*)")
       ->capture_default_str();
   cmd->add_option("--duration,-d", args->duration_s, "Stop after S seconds")
       ->check(program::positive());

@@ -117,7 +117,7 @@ void add_replay_command(CLI::App& app) {
   cmd->add_option("--start", args->options.start_s, "Skip the first S seconds of the log")
       ->check(program::non_negative());
   cmd->add_option("--channels", args->options.channels,
-                  "Regular expression matching whole channel names")
+                  "POSIX extended regular expression over whole channel names (covtrack/pose/.*)")
       ->capture_default_str();
   cmd->add_option("--lcm-url,-u", args->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or LCM's)");
   cmd->callback([args] {

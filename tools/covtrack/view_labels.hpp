@@ -20,6 +20,9 @@ struct ViewLabels {
   std::vector<client::PlacedLabel> placed;    // one per object
 };
 
+// An object's label: its name and assessment, or that it has no region.
+std::string label_text(const std::string& name, const client::ObjectRegions& regions);
+
 // widgets may be null (`covtrack regions --png`: no widgets).
 ViewLabels layout_labels(const RegionsReport& report, const WidgetFrame* widgets, const cv::Size& screen);
 

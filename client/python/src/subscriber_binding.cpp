@@ -12,7 +12,6 @@
 #include <map>
 #include <mutex>
 #include <optional>
-#include <regex>
 #include <set>
 #include <thread>
 
@@ -21,6 +20,7 @@
 #include "bindings.hpp"
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/client/transform_graph.hpp"
+#include "covtrack/protocol/channel_pattern.hpp"
 
 namespace covtrack::python {
 namespace {
@@ -82,11 +82,8 @@ std::set<PySubscriber*> open_subscribers;  // closed at interpreter exit
 class PySubscriber {
  public:
   PySubscriber(const std::optional<std::string>& lcm_url, const std::string& streams, double stale_after_s) {
-    try {
-      std::regex(streams, std::regex::extended);
-    } catch (const std::regex_error& e) {
-      throw py::value_error("streams: bad regular expression '" + streams + "': " + e.what());
-    }
+    if (auto pattern = compile_channel_pattern(streams); !pattern)
+      throw py::value_error("streams: " + pattern.error().message);
     if (!(stale_after_s > 0)) throw py::value_error("stale_after_s must be positive");
     client::SubscriberOptions options;
     options.lcm_url = lcm_url.value_or("");

@@ -1,15 +1,15 @@
 #include "covtrack/lcmlog/channel_filter.hpp"
 
+#include "covtrack/protocol/channel_pattern.hpp"
+
 namespace covtrack::lcmlog {
 
 Result<ChannelFilter> ChannelFilter::create(const std::string& pattern) {
-  try {
-    ChannelFilter filter(pattern, std::regex(pattern, std::regex::ECMAScript));
-    filter.match_all_ = pattern == ".*";
-    return filter;
-  } catch (const std::regex_error& e) {
-    return fail("channel regex '" + pattern + "' is invalid: " + e.what());
-  }
+  auto regex = compile_channel_pattern(pattern);
+  if (!regex) return std::unexpected(regex.error());
+  ChannelFilter filter(pattern, std::move(*regex));
+  filter.match_all_ = pattern == ".*";
+  return filter;
 }
 
 bool ChannelFilter::matches(std::string_view channel) {

@@ -38,6 +38,13 @@ Result<void> add_scene_transforms(const Scene& scene, client::TransformGraph& gr
     if (auto r = graph.update(t.child, report_of(scripted_value(t, 0), *reports_at_us)); !r)
       return where(r.error());
   }
+  for (const SceneFusion& f : scene.fused) {
+    std::optional<client::Combiner> combiner;
+    if (f.combiner == FusionCombiner::covariance_intersection) combiner = client::Combiner::covariance_intersection();
+    if (f.combiner == FusionCombiner::smallest) combiner = client::Combiner::smallest();
+    if (auto r = graph.add_fused_frame(f.parent, f.frame, f.via, std::move(combiner)); !r)
+      return fail(fmt::format("fused {} -> {}: {}", f.parent, f.frame, r.error().message));
+  }
   return {};
 }
 

@@ -44,7 +44,7 @@ namespace covtrack::client {
 
 struct SubscriberOptions {
   std::string lcm_url = {};      // empty: $LCM_DEFAULT_URL, else LCM's default
-  std::string pattern = ".*";    // POSIX extended regex over "device/sensor", whole match
+  std::string pattern = ".*";    // over "device/sensor" (protocol/channel_pattern.hpp)
   double stale_after_s = 0.5;    // a stream is stale after this long without a message
   // LCM drops the newest message silently when a subscription's queue is full (default
   // 30); this is that queue's length, large enough for a burst of several seconds.

@@ -12,6 +12,14 @@
 // its last report (graph_staleness.hpp); a LOST or never reported edge on the path makes
 // the result unbounded.
 //
+// Fused frames: one physical frame estimated along several paths (a marker seen by a
+// camera and a room tracker's sensor on the same object) is declared once per path, as
+// ordinary frames, plus a fused frame whose edge from a common parent combines the paths
+// (add_fused_frame). Paths that share edges are correlated; the graph knows through which
+// edges and fuses them by generalised least squares with that exact first-order
+// correlation (graph_fusion.hpp), and keeps it when a query passes through the fused
+// frame and through those shared edges again.
+//
 // Thread safety: every method may be called from any thread (one mutex). A query reads all
 // edges under one lock, so it never mixes two versions of the graph. Combiner callbacks run
 // under that lock: they must not call the graph.
@@ -60,16 +68,19 @@ struct TrackedSource {
 
 using EdgeSource = std::variant<StaticSource, TrackedSource>;
 
-// Which source a combined edge on the path used, for the caller to see.
+// Which source a combined edge, or which path a fused frame, used, for the caller to see.
 struct EdgeChoice {
   std::string child_frame;  // names the edge
-  std::size_t chosen = 0;   // index into the edge's sources
+  std::size_t chosen = 0;   // index into the edge's sources or the fused frame's paths; for
+                            // a fusion, the one it was linearised at
   bool fused = false;
 };
 
 struct QueryResult {
   UncertainPose pose;
-  std::vector<EdgeChoice> combiner_choices;  // one per combined edge on the path
+  // One per combined edge or fused frame the query used (also those inside a fused frame's
+  // paths), in the order they were evaluated.
+  std::vector<EdgeChoice> combiner_choices;
 };
 
 class TransformGraph {
@@ -85,6 +96,21 @@ class TransformGraph {
   // Fails on an empty source list.
   Result<void> add_combined_edge(const std::string& parent, const std::string& child,
                                  std::vector<EdgeSource> sources, Combiner combiner);
+  // Adds `child` with the edge parent -> child estimated along several paths: T_parent_via
+  // for each frame in `via`, each of which stands for the same physical frame as `child`
+  // reached another way through the graph. `parent` and every via frame must exist and be
+  // in one tree; `child` is new, or a root whose tree holds none of them. Paths that
+  // report LOST are left out; with none left the edge is unbounded.
+  // The fusion is the best estimate of T_parent_child. A query from another frame gets the
+  // right covariance through it, but not always a smaller one than a single path would
+  // give there: fuse relative to the frame the pose is needed in (the camera, to draw).
+  // Without a combiner the paths are fused jointly with their exact correlation (shared
+  // edges counted once). A combiner instead sees each path's estimate alone (smallest
+  // covariance; covariance intersection, which needs no correlation; a callback); a result
+  // it fuses itself counts as independent of every other edge.
+  Result<void> add_fused_frame(const std::string& parent, const std::string& child,
+                               std::vector<std::string> via,
+                               std::optional<Combiner> combiner = std::nullopt);
 
   // Stores the latest report of a stream (for every edge bound to it). A report measured
   // before the stored one is ignored (out-of-order delivery). Fails if no edge is bound to
@@ -115,8 +141,10 @@ class TransformGraph {
  private:
   using FrameIndex = std::size_t;  // into frames_
   struct Edge {
-    std::vector<EdgeSource> sources;
-    std::optional<Combiner> combiner;  // set when there are several sources
+    std::vector<EdgeSource> sources;   // none for a fused frame
+    std::optional<Combiner> combiner;  // set when there are several sources, or for a fused
+                                       // frame that does not fuse jointly
+    std::vector<FrameIndex> via;       // a fused frame: the frames its paths lead to
   };
   struct Frame {
     std::string name;
@@ -127,8 +155,10 @@ class TransformGraph {
     UncertainPose value;
     std::optional<EdgeChoice> choice;
   };
+  struct QueryState;  // the edges one query has evaluated (transform_graph.cpp)
 
   Result<void> add_edge(const std::string& parent, const std::string& child, Edge edge);
+  Result<void> link(const std::string& parent, const std::string& child, Edge edge);  // locked
   Result<void> store_report(const StreamId& stream, const TrackedTransform& report);
   std::optional<std::string> mismatch_of(const StreamId& stream, const TrackedTransform& report) const;
   std::optional<FrameIndex> find(const std::string& frame) const;
@@ -137,6 +167,14 @@ class TransformGraph {
   std::vector<FrameIndex> ancestry(FrameIndex frame) const;  // frame, ..., root
   UncertainPose source_value(const EdgeSource& source, std::int64_t now_us) const;
   Result<EdgeValue> edge_value(FrameIndex child, std::int64_t now_us) const;
+  // Each evaluates into `state` (once per query) and fails only on a combiner's error.
+  Result<void> evaluate_edge(FrameIndex child, QueryState& state) const;
+  Result<void> evaluate_fused(FrameIndex child, QueryState& state) const;
+  // The child frames of the edges from A up to the LCA and from B up to it.
+  struct TreePath {
+    std::vector<FrameIndex> up_A, up_B;
+  };
+  std::optional<TreePath> tree_path(FrameIndex A, FrameIndex B) const;
 
   mutable std::mutex mutex_;
   Propagation mode_;

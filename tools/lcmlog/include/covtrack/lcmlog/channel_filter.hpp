@@ -1,6 +1,6 @@
 #pragma once
-// Which channels a command handles: a regular expression that must match the whole
-// channel name, as LCM's own subscribe() does ("covtrack/pose/.*", not "pose").
+// Which channels a command handles: a pattern over whole channel names
+// (protocol/channel_pattern.hpp: POSIX extended, as LCM's own subscribe(); "covtrack/pose/.*", not "pose").
 #include <regex>
 #include <string>
 #include <string_view>

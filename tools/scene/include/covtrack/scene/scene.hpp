@@ -35,6 +35,17 @@ struct SceneTransform {
   bool lost = false;  // a scripted value: the report at this time is LOST
 };
 
+// How a fused frame combines its paths (client::TransformGraph::add_fused_frame).
+enum class FusionCombiner { joint, covariance_intersection, smallest };
+
+// One physical frame estimated along several paths: each via frame stands for it.
+struct SceneFusion {
+  std::string frame;
+  std::string parent;
+  std::vector<std::string> via;
+  FusionCombiner combiner = FusionCombiner::joint;
+};
+
 // Level-of-Error augmentations `covtrack view` can draw (dissertation 5.6.2,
 // docs/background.md), from the one that relies most on registration to the one that
 // relies on it least.
@@ -70,6 +81,7 @@ struct SceneCamera {
 
 struct Scene {
   std::vector<SceneTransform> transforms;
+  std::vector<SceneFusion> fused;  // added after every transform, in order
   SceneCamera camera;
   std::vector<SceneObject> objects;
   std::optional<ScenePointer> pointer;

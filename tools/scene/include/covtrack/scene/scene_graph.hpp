@@ -11,7 +11,7 @@
 
 namespace covtrack::scene {
 
-// Adds every transform of the scene to `graph`. Tracked ones are bound to their streams
+// Adds every transform of the scene to `graph`, then its fused frames. Tracked ones are bound to their streams
 // with their motion bounds. With `reports_at_us`, each tracked edge also receives its
 // scene value as a report measured at that time: the offline "what if the tracker
 // reports this" case. Without it, tracked edges stay LOST until their streams report.
