@@ -8,6 +8,9 @@
 //    its precision against its best single tag, and how rarely consistent bundles are
 //    called DEGRADED. Each frame is one random camera of the calibration's population, so
 //    frames are independent draws of the systematic corner errors.
+//  - The same renders' corner errors split by the corner model's terms (apparent scale,
+//    each edge's placement, each edge's turn) against the model's variance of each, and
+//    the apparent scale's correlation between the tags of one frame.
 //  - A board whose tag sits 2 cm from where its config says: DEGRADED, the tag named and
 //    left out, the truth inside the 99% region.
 #include <gtest/gtest.h>
@@ -83,7 +86,6 @@ struct FrameResult {
   std::optional<Pose> best_tag;  // the most precise single tag's pose, mapped to the bundle
   Mat6 best_tag_covariance = Mat6::Zero();
   std::vector<BundleObservation> seen;  // the bundle's tags as posed on their own
-  std::vector<CornerNoise> noise;       // what the corner model said about each of them
 };
 
 // Renders bundles and poses them as the driver does (detection, corner model, tag poses,
@@ -127,7 +129,6 @@ class Renderer {
       auto pose = estimate_tag_pose(camera_, d.corners_px, tag->size_m, corner_noise);
       if (!pose) continue;  // a tag cut by the frame's edge is refused
       out.seen.push_back({*tag, *pose});
-      out.noise.push_back(corner_noise);
       // The best single tag: the smallest covariance of the pose it gives the bundle.
       const Mat6 A = se3_adjoint(tag->T_bundle_tag);
       const Mat6 C = A * pose->covariance * A.transpose();
@@ -255,11 +256,10 @@ TEST(FiducialBundle, NeesOfTheBundlePoseOnHeldOutRenders) {
   EXPECT_LT(sum[1] / n[1], tent_hi);
   // The tents (a non-planar object) within both bounds.
   EXPECT_GT(sum[1] / n[1], tent_lo);
-  // The boards are under-confident, about 2x (measured 3.1): the corner model's per-edge
-  // terms are larger than these renders' errors and its turn terms smaller, which a single
-  // tag's pose, dominated by its apparent size, does not show (devices/fiducial/README.md,
-  // "Tag bundles"). This bounds it at 2.5x.
-  EXPECT_GT(sum[0] / n[0], 6 / 2.5);
+  // The boards are still under-confident, 1.7x (measured 3.60): the model's per-edge
+  // placement term, calibrated on other renders, is 1.8x what these board tags show
+  // (devices/fiducial/README.md, "Still weak"). This bounds it at 2x.
+  EXPECT_GT(sum[0] / n[0], 6 / 2.0);
   // Consistent tags are rarely called inconsistent at the default limit.
   EXPECT_LE(degraded * 100, all * 5) << "consistent bundles DEGRADED";
 }
@@ -356,29 +356,6 @@ TEST(FiducialBundle, ResidualsByTermOnHeldOutRenders) {
       p.observed[2] += q.tail<4>().squaredNorm(), p.modelled[2] += C.bottomRightCorner<4, 4>().trace();
       scale.push_back(s);
       ++p.tags;
-      {  // TEMP split by term
-        static double acc[2][5][2];
-        const CornerNoise& nz = f.noise[scale.size() - 1];
-        for (int term = 0; term < 5; ++term) {
-          CornerNoise only{}; only.sigma_px = 1e-12;
-          if (term == 0) only.sigma_px = nz.sigma_px;
-          if (term == 1) only.extra_px = nz.extra_px;
-          if (term == 2) only.edge_sigma_px = nz.edge_sigma_px;
-          if (term == 3) only.scale_sigma_px = nz.scale_sigma_px;
-          if (term == 4) only.tilt_sigma_px = nz.tilt_sigma_px;
-          const Eigen::Matrix<double, 8, 8> Ct = to_modes * corner_covariance(o.pose.corners_px, only) * to_modes.transpose();
-          const Eigen::Matrix4d ot = Ct.topLeftCorner<4, 4>();
-          acc[f.tent][term][0] += (rest * ot * rest).trace(), acc[f.tent][term][1] += Ct.bottomRightCorner<4, 4>().trace();
-        }
-        if (&f == &consistent_frames().back() && &o == &f.seen.back())
-          for (int t = 0; t < 2; ++t) {
-            std::printf("TEMP %s placement by term (sigma extra edge scale tilt):", t ? "tent" : "board");
-            for (int term = 0; term < 5; ++term) std::printf(" %.5f", acc[t][term][0] / parts[t].tags);
-            std::printf("  turns:");
-            for (int term = 0; term < 5; ++term) std::printf(" %.5f", acc[t][term][1] / parts[t].tags);
-            std::printf("\n");
-          }
-      }
     }
     for (std::size_t i = 0; i < scale.size(); ++i)
       for (std::size_t j = i + 1; j < scale.size(); ++j)
@@ -394,7 +371,10 @@ TEST(FiducialBundle, ResidualsByTermOnHeldOutRenders) {
                 p.observed[1] / p.modelled[1], p.observed[2] / p.tags, p.modelled[2] / p.tags,
                 p.observed[2] / p.modelled[2], corr);
     ASSERT_GT(p.tags, 100);
-    // Each part of the model within 2x of what these renders show.
+    // The bundle's joint covariance takes the apparent-scale error as shared by a frame's tags.
+    EXPECT_GT(corr, 0.8) << (tent ? "tent" : "board");
+    // Each part of the model within 2x of what these renders show (with the corners taken as
+    // independent, the board tags' edge placement was 0.37x and their turns 1.76x).
     for (int k = 0; k < 3; ++k) {
       EXPECT_GT(p.observed[k] / p.modelled[k], 0.5) << (tent ? "tent" : "board") << " part " << k;
       EXPECT_LT(p.observed[k] / p.modelled[k], 2.0) << (tent ? "tent" : "board") << " part " << k;
