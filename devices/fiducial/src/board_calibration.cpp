@@ -142,6 +142,11 @@ const BundleTag* board_tag(const TagBundle& board, int id) {
 }
 
 // The board's tags in one frame posed under `model` (those the pose refuses are left out).
+// Their apparent-scale errors are taken as independent here, not shared as a bundle takes
+// them: the fit's residual model holds a tag and the others' prediction of it as
+// independent, which a shared term would break (with it, corners drawn from known models
+// gave an edge factor 1.57x the truth). What a camera's tags share is mostly its bias b,
+// which the fit takes out.
 std::vector<BundleObservation> pose_tags(const CameraModel& camera, const TagBundle& board, const BoardFrame& frame,
                                          const CornerNoiseModel& model, double ambiguity_chi2) {
   std::vector<BundleObservation> out;
@@ -149,7 +154,9 @@ std::vector<BundleObservation> pose_tags(const CameraModel& camera, const TagBun
     const BundleTag* tag = board_tag(board, d.detection.id);
     if (!tag) continue;
     auto pose = estimate_tag_pose(camera, d.detection.corners_px, tag->size_m, model.noise(d.inputs), ambiguity_chi2);
-    if (pose) out.push_back({*tag, *pose});
+    if (!pose) continue;
+    pose->scale_mode_px.setZero();
+    out.push_back({*tag, *pose});
   }
   return out;
 }
