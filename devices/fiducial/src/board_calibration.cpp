@@ -31,7 +31,7 @@ struct Residual {
   Vec8 bias_direction;    // M 1: the corners' motion when all four edges move out by 1 px
   // The shapes of the edge, scale and turn terms: M M^T, (M 1)(M 1)^T, N N^T.
   Mat8 edge_shape, scale_shape, tilt_shape;
-  Mat8 independent;       // the starting model's edge-fit noise (image noise and floor)
+  Vec8 independent_var;   // the starting model's, per coordinate: image noise and floor
   Vec8 shift_var;         //   and what its white-cell shift correction misses
   double scale_sd = 0, edge_sd = 0, tilt_sd = 0;  // the starting model's, at this blur
   double polarity_blur = 0;
@@ -53,8 +53,7 @@ Mat8 covariance_of(const Residual& v, const Params& p) {
   const double kI = std::exp(p[1]), kS = std::exp(p[2]), kE = std::exp(p[3]);
   const double e2 = std::pow(kE * v.edge_sd, 2), s2 = std::pow(kS * v.scale_sd, 2), t2 = std::pow(v.tilt_sd, 2);
   Mat8 S = e2 * v.edge_shape + s2 * v.scale_shape + t2 * v.tilt_shape + v.prediction;
-  S += kI * kI * v.independent;
-  S.diagonal() += v.shift_var;
+  S.diagonal() += kI * kI * v.independent_var + v.shift_var;
   return S;
 }
 
@@ -142,11 +141,6 @@ const BundleTag* board_tag(const TagBundle& board, int id) {
 }
 
 // The board's tags in one frame posed under `model` (those the pose refuses are left out).
-// Their apparent-scale errors are taken as independent here, not shared as a bundle takes
-// them: the fit's residual model holds a tag and the others' prediction of it as
-// independent, which a shared term would break (with it, corners drawn from known models
-// gave an edge factor 1.57x the truth). What a camera's tags share is mostly its bias b,
-// which the fit takes out.
 std::vector<BundleObservation> pose_tags(const CameraModel& camera, const TagBundle& board, const BoardFrame& frame,
                                          const CornerNoiseModel& model, double ambiguity_chi2) {
   std::vector<BundleObservation> out;
@@ -154,9 +148,7 @@ std::vector<BundleObservation> pose_tags(const CameraModel& camera, const TagBun
     const BundleTag* tag = board_tag(board, d.detection.id);
     if (!tag) continue;
     auto pose = estimate_tag_pose(camera, d.detection.corners_px, tag->size_m, model.noise(d.inputs), ambiguity_chi2);
-    if (!pose) continue;
-    pose->scale_mode_px.setZero();
-    out.push_back({*tag, *pose});
+    if (pose) out.push_back({*tag, *pose});
   }
   return out;
 }
@@ -199,10 +191,10 @@ std::vector<Residual> residuals_of(const CameraModel& camera, const TagBundle& b
         v.r(2 * k) = unbiased_pose->corners_px[k].x - p.x;
         v.r(2 * k + 1) = unbiased_pose->corners_px[k].y - p.y;
         J.block<2, 6>(2 * k, 0) = point_jacobian(camera, placed->T_camera_bundle, X_board);
+        v.independent_var(2 * k) = v.independent_var(2 * k + 1) = noise.sigma_px * noise.sigma_px;
         v.shift_var(2 * k) = v.shift_var(2 * k + 1) = noise.extra_px[k] * noise.extra_px[k];
       }
       const Mat8 modes = edge_line_modes(unbiased_pose->corners_px);
-      v.independent = noise.sigma_px * noise.sigma_px * edge_fit_noise_shape(unbiased_pose->corners_px);
       const Mat84 out_modes = modes.leftCols<4>(), turn_modes = modes.rightCols<4>();
       v.bias_direction = out_modes * Eigen::Vector4d::Ones();
       v.edge_shape = out_modes * out_modes.transpose();

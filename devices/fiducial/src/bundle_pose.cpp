@@ -16,21 +16,11 @@ using Vec8 = Eigen::Matrix<double, 8, 1>;
 using Mat8 = Eigen::Matrix<double, 8, 8>;
 
 // One tag's corners as the bundle's fit sees them: where they are on the bundle, where
-// they were measured, their covariance, and how they move with the tag's apparent-scale
-// error (the part of that covariance the bundle's tags share).
+// they were measured, and the whitening W (W^T W = Sigma^-1) of their covariance.
 struct TagCorners {
-  int id = 0;
   std::array<Vec3, 4> X_bundle;
   Vec8 measured;
-  Mat8 covariance;
-  Vec8 scale_mode;
-};
-
-// A set of tags' corners and the whitening W (W^T W = Sigma^-1) of their joint covariance:
-// each tag's own block, and between two tags the apparent-scale error they share.
-struct JointCorners {
-  std::vector<TagCorners> tags;
-  Eigen::MatrixXd whiten;
+  Mat8 whiten;
 };
 
 struct Fit {
@@ -39,80 +29,67 @@ struct Fit {
   double cost = std::numeric_limits<double>::infinity();  // sum of squared whitened residuals
 };
 
-TagCorners corners_of(const BundleObservation& o) {
+Result<TagCorners> corners_of(const BundleObservation& o) {
   TagCorners t;
-  t.id = o.tag.id;
   const auto X = tag_corner_points(o.tag.size_m);
   for (int k = 0; k < 4; ++k) {
     t.X_bundle[k] = o.tag.T_bundle_tag * X[k];
     t.measured(2 * k) = o.pose.corners_px[k].x, t.measured(2 * k + 1) = o.pose.corners_px[k].y;
   }
-  t.covariance = o.pose.corner_covariance;
-  t.scale_mode = o.pose.scale_mode_px;
+  const Eigen::LLT<Mat8> llt(o.pose.corner_covariance);
+  if (llt.info() != Eigen::Success) return fail(fmt::format("tag {}: corner covariance is not positive definite", o.tag.id));
+  t.whiten = llt.matrixL().solve(Mat8::Identity());
   return t;
 }
 
-Result<JointCorners> joint(std::vector<TagCorners> tags) {
-  const auto n = static_cast<Eigen::Index>(tags.size());
-  Eigen::MatrixXd sigma(8 * n, 8 * n);
-  for (Eigen::Index i = 0; i < n; ++i)
-    for (Eigen::Index j = 0; j < n; ++j)
-      sigma.block<8, 8>(8 * i, 8 * j) = i == j ? tags[static_cast<std::size_t>(i)].covariance
-                                               : Mat8(tags[static_cast<std::size_t>(i)].scale_mode *
-                                                      tags[static_cast<std::size_t>(j)].scale_mode.transpose());
-  const Eigen::LLT<Eigen::MatrixXd> llt(sigma);
-  if (llt.info() != Eigen::Success) {
-    std::vector<int> ids;
-    for (const auto& t : tags) ids.push_back(t.id);
-    return fail(fmt::format("tags {}: corner covariance is not positive definite", fmt::join(ids, ", ")));
-  }
-  JointCorners out{std::move(tags), llt.matrixL().solve(Eigen::MatrixXd::Identity(8 * n, 8 * n))};
-  return out;
-}
-
 // Every observation's corners, in the order given.
-Result<JointCorners> corners_of_all(const std::vector<BundleObservation>& observations) {
+Result<std::vector<TagCorners>> corners_of_all(const std::vector<BundleObservation>& observations) {
   std::vector<TagCorners> tags;
-  for (const auto& o : observations) tags.push_back(corners_of(o));
-  return joint(std::move(tags));
+  for (const auto& o : observations) {
+    auto t = corners_of(o);
+    if (!t) return std::unexpected(t.error());
+    tags.push_back(*t);
+  }
+  return tags;
 }
 
 // Whitened residuals of the tags' corners at T; false when a corner is behind the camera.
-bool residuals(const CameraModel& cam, const JointCorners& corners, const Pose& T, Eigen::VectorXd& r) {
-  const auto& tags = corners.tags;
-  Eigen::VectorXd d(8 * static_cast<Eigen::Index>(tags.size()));
-  for (std::size_t i = 0; i < tags.size(); ++i)
+bool residuals(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T, Eigen::VectorXd& r) {
+  r.resize(8 * static_cast<Eigen::Index>(tags.size()));
+  for (std::size_t i = 0; i < tags.size(); ++i) {
+    Vec8 d;
     for (int k = 0; k < 4; ++k) {
       const Vec3 p = T * tags[i].X_bundle[k];
       if (!(p.z() > 0)) return false;
       const cv::Point2d u = cam.project(p);
-      const auto row = static_cast<Eigen::Index>(8 * i + 2 * k);
-      d(row) = tags[i].measured(2 * k) - u.x, d(row + 1) = tags[i].measured(2 * k + 1) - u.y;
+      d(2 * k) = tags[i].measured(2 * k) - u.x, d(2 * k + 1) = tags[i].measured(2 * k + 1) - u.y;
     }
-  r = corners.whiten.triangularView<Eigen::Lower>() * d;
+    r.segment<8>(8 * static_cast<Eigen::Index>(i)) = tags[i].whiten * d;
+  }
   return true;
 }
 
-double cost_at(const CameraModel& cam, const JointCorners& tags, const Pose& T) {
+double cost_at(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T) {
   Eigen::VectorXd r;
   return residuals(cam, tags, T, r) ? r.squaredNorm() : std::numeric_limits<double>::infinity();
 }
 
 // J^T Sigma^-1 J at T (the information of the BODY perturbation) and J^T Sigma^-1 r.
-void normal_equations(const CameraModel& cam, const JointCorners& corners, const Pose& T, Mat6& H, Vec6& g) {
+void normal_equations(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T, Mat6& H, Vec6& g) {
+  H.setZero(), g.setZero();
   Eigen::VectorXd r;
-  residuals(cam, corners, T, r);
-  Eigen::MatrixXd J(8 * static_cast<Eigen::Index>(corners.tags.size()), 6);
-  for (std::size_t i = 0; i < corners.tags.size(); ++i)
-    for (int k = 0; k < 4; ++k)
-      J.block<2, 6>(static_cast<Eigen::Index>(8 * i + 2 * k), 0) = point_jacobian(cam, T, corners.tags[i].X_bundle[k]);
-  const Eigen::MatrixXd Jw = corners.whiten.triangularView<Eigen::Lower>() * J;
-  H = Jw.transpose() * Jw;
-  g = Jw.transpose() * r;
+  residuals(cam, tags, T, r);
+  for (std::size_t i = 0; i < tags.size(); ++i) {
+    Eigen::Matrix<double, 8, 6> J;
+    for (int k = 0; k < 4; ++k) J.block<2, 6>(2 * k, 0) = point_jacobian(cam, T, tags[i].X_bundle[k]);
+    const Eigen::Matrix<double, 8, 6> Jw = tags[i].whiten * J;
+    H += Jw.transpose() * Jw;
+    g += Jw.transpose() * r.segment<8>(8 * static_cast<Eigen::Index>(i));
+  }
 }
 
 // Gauss-Newton from T0, halving a step that does not lower the cost.
-Fit gauss_newton(const CameraModel& cam, const JointCorners& tags, const Pose& T0) {
+Fit gauss_newton(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T0) {
   Fit f{T0, Mat6::Zero(), cost_at(cam, tags, T0)};
   if (!std::isfinite(f.cost)) return f;
   Mat6 H;
@@ -159,7 +136,7 @@ BundlePose from_one_tag(const BundleObservation& o) {
 }
 
 // Corner-space chi2 between two poses: how well the data tells them apart.
-double separation_chi2(const CameraModel& cam, const JointCorners& tags, const Pose& a, const Pose& b) {
+double separation_chi2(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& a, const Pose& b) {
   Eigen::VectorXd ra, rb;
   if (!residuals(cam, tags, a, ra) || !residuals(cam, tags, b, rb)) return std::numeric_limits<double>::infinity();
   return (ra - rb).squaredNorm();  // the measured corners cancel
@@ -201,7 +178,7 @@ Result<BundlePose> estimate_bundle_pose(const CameraModel& cam, const std::vecto
   if (observations.size() == 1) return from_one_tag(observations[0]);
   auto corners = corners_of_all(observations);
   if (!corners) return std::unexpected(corners.error());
-  const JointCorners& tags = *corners;
+  const std::vector<TagCorners>& tags = *corners;
 
   // Starts: both solutions of every tag, mapped to the bundle, lowest cost first. A start
   // near a minimum already found would only find it again (0.01: 0.6 degrees or 1 cm, far
@@ -253,10 +230,8 @@ Result<BundlePose> estimate_bundle_pose(const CameraModel& cam, const std::vecto
     for (std::size_t m = 0; m < members.size(); ++m) {
       std::vector<TagCorners> others;
       for (std::size_t k = 0; k < members.size(); ++k)
-        if (k != m) others.push_back(tags.tags[members[k]]);
-      auto others_joint = joint(std::move(others));  // a principal block of a positive definite matrix
-      if (!others_joint) return std::unexpected(others_joint.error());
-      without.push_back(gauss_newton(cam, *others_joint, fit.T));
+        if (k != m) others.push_back(tags[members[k]]);
+      without.push_back(gauss_newton(cam, others, fit.T));
       agreement.push_back(agreement_of(cam, observations[members[m]], without.back(), consistency_chi2));
     }
     const auto worst = static_cast<std::size_t>(
@@ -302,7 +277,7 @@ Result<BundlePose> refine_bundle_pose(const CameraModel& cam, const std::vector<
                                       const Pose& start) {
   auto corners = corners_of_all(observations);
   if (!corners) return std::unexpected(corners.error());
-  const JointCorners& tags = *corners;
+  const std::vector<TagCorners>& tags = *corners;
   const Fit fit = gauss_newton(cam, tags, start);
   if (!std::isfinite(fit.cost) || !fit.covariance.allFinite()) return fail("no bundle pose near the start fits");
   BundlePose out;

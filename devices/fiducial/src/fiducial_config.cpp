@@ -62,29 +62,29 @@ const TableSpec& fiducial_device_spec() {
 
 std::vector<KeySpec> corner_model_keys() {
   return {
-        {"corner_gain_px", ValueType::Float, "px", "1.1030", "corner noise model: noise/contrast gain "
+        {"corner_gain_px", ValueType::Float, "px", "1.1673", "corner noise model: noise/contrast gain "
          "(devices/fiducial/README.md)", 0, 100},
-        {"corner_floor_px", ValueType::Float, "px", "0.0411", "corner noise model: per-camera floor", 0, 100},
-        {"corner_aligned_px", ValueType::Float, "px", "0.0493", "corner noise model: edges along "
+        {"corner_floor_px", ValueType::Float, "px", "0.0436", "corner noise model: per-camera floor", 0, 100},
+        {"corner_aligned_px", ValueType::Float, "px", "0.0522", "corner noise model: edges along "
          "pixel axes", 0, 100},
         {"corner_shift_px", ValueType::Float, "px", "1.6552", "corner noise model: outward shift of "
          "an edge lined inside by white cells, at zero border width (corrected)", 0, 100},
         {"corner_shift_falloff", ValueType::Float, "", "0.20", "corner noise model: that shift "
          "fades as exp(-falloff (border / blur)^2)", 0, 100},
-        {"corner_shift_sigma_px", ValueType::Float, "px", "1.7443", "corner noise model: what the "
+        {"corner_shift_sigma_px", ValueType::Float, "px", "1.8573", "corner noise model: what the "
          "shift correction misses, at full reach", 0, 100},
         {"corner_scale_bias_per_blur", ValueType::Float, "", "-0.2578", "corner noise model: every "
          "edge's mean outward error per px of edge blur for a dark square (a light one: the "
          "opposite), from the camera's tone curve (removed)", -10, 10},
-        {"corner_scale_sigma_px", ValueType::Float, "px", "0.0610", "corner noise model: spread of "
+        {"corner_scale_sigma_px", ValueType::Float, "px", "0.0642", "corner noise model: spread of "
          "the four edges' common outward error (the tag's apparent size), floor", 0, 100},
-        {"corner_scale_per_blur", ValueType::Float, "", "0.1147", "corner noise model: that spread's "
+        {"corner_scale_per_blur", ValueType::Float, "", "0.1207", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},
         {"corner_edge_sigma_px", ValueType::Float, "px", "0", "corner noise model: spread of each "
          "edge's own outward error, floor", 0, 100},
-        {"corner_edge_per_blur", ValueType::Float, "", "0.0268", "corner noise model: that spread's "
+        {"corner_edge_per_blur", ValueType::Float, "", "0.0282", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},
-        {"corner_tilt_sigma_px", ValueType::Float, "px", "0.0094", "corner noise model: spread of "
+        {"corner_tilt_sigma_px", ValueType::Float, "px", "0.0099", "corner noise model: spread of "
          "each edge's own turn (its ends' opposite outward errors), floor", 0, 100},
         {"corner_tilt_per_blur", ValueType::Float, "", "0", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},

@@ -157,16 +157,11 @@ std::vector<std::vector<CornerSample>> corner_samples(const CornerNoiseModel& mo
       const CornerInputs& in = de.draw->inputs;
       const auto reach = model.edge_reach(in);
       const double noise = CornerNoiseModel::noise_term(in.image_noise, in.contrast, in.edge_length_px);
-      // The edge fits' noise reaches a corner through its two edges' lines: per coordinate,
-      // half the trace of its 2x2 block (1 where the edges meet at a right angle).
-      const auto shape = edge_fit_noise_shape(de.draw->detection->corners_px);
       for (std::size_t k = 0; k < 4; ++k) {
         const std::size_t a = (k + 3) % 4;  // corner k joins edges k - 1 and k
         const double r = reach[a] * reach[a] + reach[k] * reach[k];
-        const auto i = static_cast<Eigen::Index>(2 * k);
-        const double g = (shape(i, i) + shape(i + 1, i + 1)) / 2;
         const cv::Point2d e = de.errors.error_px[k] - mean[k];
-        samples.push_back({Vec4(g, g * noise, g * in.axis_alignment, r), e.dot(e) * n / (n - 1)});
+        samples.push_back({Vec4(1, noise, in.axis_alignment, r), e.dot(e) * n / (n - 1)});
       }
     }
   }

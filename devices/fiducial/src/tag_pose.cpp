@@ -98,33 +98,16 @@ Eigen::Matrix<double, 8, 8> edge_line_modes(const std::array<cv::Point2d, 4>& c)
   return M;
 }
 
-namespace {
-// The edge-mode covariance of an edge-line fit's own noise, per unit variance at an end:
-// a line fitted to points spread evenly along the edge has its offset error's variance
-// v / 4 and its turn's 3 v / 4 (at its ends, which is where the corners are), so that each
-// end has v and the two ends are correlated -1/2.
-Eigen::Matrix<double, 8, 8> line_fit_modes() {
-  Eigen::Matrix<double, 8, 8> m = Eigen::Matrix<double, 8, 8>::Zero();
-  m.diagonal() << 0.25, 0.25, 0.25, 0.25, 0.75, 0.75, 0.75, 0.75;
-  return m;
-}
-}  // namespace
-
-Eigen::Matrix<double, 8, 8> edge_fit_noise_shape(const std::array<cv::Point2d, 4>& c) {
-  const Eigen::Matrix<double, 8, 8> M = edge_line_modes(c);
-  return M * line_fit_modes() * M.transpose();
-}
-
 Eigen::Matrix<double, 8, 8> corner_covariance(const std::array<cv::Point2d, 4>& c, const CornerNoise& noise) {
   const Eigen::Matrix<double, 8, 8> M = edge_line_modes(c);
-  Eigen::Matrix<double, 8, 8> edges = noise.sigma_px * noise.sigma_px * line_fit_modes();
-  edges.topLeftCorner<4, 4>() += noise.edge_sigma_px * noise.edge_sigma_px * Eigen::Matrix4d::Identity() +
-                                 noise.scale_sigma_px * noise.scale_sigma_px * Eigen::Matrix4d::Ones();
-  edges.bottomRightCorner<4, 4>() += noise.tilt_sigma_px * noise.tilt_sigma_px * Eigen::Matrix4d::Identity();
+  Eigen::Matrix<double, 8, 8> edges = Eigen::Matrix<double, 8, 8>::Zero();
+  edges.topLeftCorner<4, 4>() = noise.edge_sigma_px * noise.edge_sigma_px * Eigen::Matrix4d::Identity() +
+                                noise.scale_sigma_px * noise.scale_sigma_px * Eigen::Matrix4d::Ones();
+  edges.bottomRightCorner<4, 4>() = noise.tilt_sigma_px * noise.tilt_sigma_px * Eigen::Matrix4d::Identity();
   Eigen::Matrix<double, 8, 8> cov = M * edges * M.transpose();
   for (int i = 0; i < 8; ++i) {
     const double extra = noise.extra_px[static_cast<std::size_t>(i / 2)];
-    cov(i, i) += extra * extra;
+    cov(i, i) += noise.sigma_px * noise.sigma_px + extra * extra;
   }
   return cov;
 }
@@ -218,7 +201,6 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
   out.corner_sigma_px = sigma;
   out.corners_px = {image[0], image[1], image[2], image[3]};
   out.corner_covariance = corner_cov;
-  out.scale_mode_px = noise.scale_sigma_px * edge_line_modes(out.corners_px).leftCols<4>().rowwise().sum();
   out.covariance = pose_covariance(corner_jacobian(cam, out.best.T_camera_tag, size_m), corner_cov);
   out.ambiguity_chi2 = std::numeric_limits<double>::infinity();
   if (solutions.size() > 1) {

@@ -3,13 +3,11 @@
 // visible corners of its tags, with its covariance, and a check that the tags agree.
 //
 // The corners are those each tag's own pose was fitted to (TagPose::corners_px: corrected,
-// undistorted), each tag with its full 8x8 corner covariance Sigma_i. Each edge's placement
-// and turn is a tag's own; its apparent-scale error is not: the camera's tone curve and
-// blur make every tag of a frame look too large or too small alike (measured correlation
-// 0.96-0.99 between a frame's tags), so the joint corner covariance Sigma has Sigma_i on
-// its diagonal blocks and m_i m_j^T between tags i and j (m_i = TagPose::scale_mode_px).
-// The bundle pose minimises r^T Sigma^-1 r, r the stacked
-//   r_i = corners_i - project(T_camera_bundle T_bundle_tag_i X_k),
+// undistorted), each tag with its full 8x8 corner covariance Sigma_i. The systematic terms
+// of Sigma_i (a tag's apparent size, each edge's placement) are shared by the corners of
+// one tag and drawn independently for another tag, so the bundle's corner covariance is
+// block-diagonal, and the bundle pose minimises
+//   sum_i r_i^T Sigma_i^-1 r_i,   r_i = corners_i - project(T_camera_bundle T_bundle_tag_i X_k)
 // by Gauss-Newton on the BODY perturbation, started from the tag pose (either solution of
 // any tag, mapped to the bundle) that fits all corners best. Covariance (J^T Sigma^-1 J)^-1
 // with the stacked Jacobian J. With one tag in view the bundle pose is that tag's pose
@@ -21,10 +19,8 @@
 //
 // Agreement (two tags or more): each tag's own pose (the nearer of its two solutions) is
 // compared with where the other tags put it, chi2 = e^T (C_tag + A C_others A^T)^-1 e on
-// 6 degrees of freedom (the two estimates share no corner; their shared apparent-scale
-// error is left out, as it moves the others' pose little: on corners drawn from the model
-// 9 of 5000 tags disagree at the 99.9% quantile; A maps a bundle perturbation to the
-// tag's frame). Above
+// 6 degrees of freedom (the two estimates share no corner, so their errors are
+// independent; A maps a bundle perturbation to the tag's frame). Above
 // `consistency_chi2` the tag disagrees and the bundle is DEGRADED:
 //  - while a strict majority of the tags in view still remains without it, the worst
 //    such tag is left out and the rest refitted (the pose and covariance of the agreeing

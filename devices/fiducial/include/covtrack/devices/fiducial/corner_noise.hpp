@@ -69,19 +69,19 @@ struct CornerInputs {
 // population (tone curves gamma 1-2.4, blur 0.4-1.25 px plus defocus, JPEG 75-97 or none;
 // devices/fiducial/README.md); config/schema.md lists the same values.
 struct CornerNoiseModel {
-  double gain_px = 1.1030;
-  double floor_px = 0.0411;
-  double aligned_px = 0.0493;
+  double gain_px = 1.1673;
+  double floor_px = 0.0436;
+  double aligned_px = 0.0522;
   double shift_px = 1.6552;        // outward edge shift with all-white cells inside, zero border
   double shift_falloff = 0.20;     // how fast it fades with border / blur (see above)
-  double shift_sigma_px = 1.7443;  // the shift correction's uncertainty at reach 1
+  double shift_sigma_px = 1.8573;  // the shift correction's uncertainty at reach 1
   double scale_bias_per_blur = -0.2578;  // every edge's mean outward error per px of blur,
                                          // for a dark square (a light one: the opposite)
-  double scale_sigma_px = 0.0610;  // the four edges' common outward error: its floor
-  double scale_per_blur = 0.1147;  //   and its growth per px of edge blur
+  double scale_sigma_px = 0.0642;  // the four edges' common outward error: its floor
+  double scale_per_blur = 0.1207;  //   and its growth per px of edge blur
   double edge_sigma_px = 0.0;      // each edge's own outward error: its floor
-  double edge_per_blur = 0.0268;   //   and its growth per px of edge blur
-  double tilt_sigma_px = 0.0094;   // each edge's own turn (its ends' opposite outward
+  double edge_per_blur = 0.0282;   //   and its growth per px of edge blur
+  double tilt_sigma_px = 0.0099;   // each edge's own turn (its ends' opposite outward
   double tilt_per_blur = 0.0;      //   errors, px at each end): floor and growth per px blur
 
   // Per edge: exp(-shift_falloff (border / blur)^2).

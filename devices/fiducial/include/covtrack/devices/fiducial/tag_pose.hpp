@@ -6,12 +6,11 @@
 // from OpenCV's IPPE_SQUARE and are polished by Levenberg-Marquardt. The covariance is
 // (J^T Sigma_c^-1 J)^-1, J the Jacobian of the four projected corners w.r.t. xi, and the
 // full 8x8 corner covariance
-//   Sigma_c = diag(extra_k^2) + M (sigma^2 / 4 + edge_sigma^2) M^T + scale_sigma^2 M 1 1^T M^T
-//             + N (3 sigma^2 / 4 + tilt_sigma^2) N^T,
+//   Sigma_c = diag(sigma^2 + extra_k^2) + M (edge_sigma^2 I + scale_sigma^2 1 1^T) M^T
+//             + tilt_sigma^2 N N^T,
 // M's column e the corners' displacement when edge e's line moves out by 1 px, N's when
-// it turns so that its start moves out by 1 px and its end in by 1 px (sigma: each edge
-// line fit's own noise at its ends, split between the line's offset and its turn as a
-// straight-line fit splits it; extra_k: corner k's edge-shift term; see corner_noise.hpp). Corners are first corrected: each
+// it turns so that its start moves out by 1 px and its end in by 1 px (extra_k:
+// corner k's edge-shift term; see corner_noise.hpp). Corners are first corrected: each
 // edge's line is moved back in by its predicted outward shift. The second pose is told apart from the best
 // by the Mahalanobis distance, under Sigma_c, between the corners each predicts; below
 // `ambiguity_chi2` the covariance gets the outer product of the step to it, so that it
@@ -48,10 +47,6 @@ struct TagPose {
   // stacks these of its tags).
   std::array<cv::Point2d, 4> corners_px{};
   Eigen::Matrix<double, 8, 8> corner_covariance = Eigen::Matrix<double, 8, 8>::Zero();
-  // Its apparent-scale term: how the corners move for a one-sigma error of the four edges'
-  // common outward placement (scale_sigma M 1; part of corner_covariance). The tags of one
-  // frame share it: a bundle correlates their corners through it.
-  Eigen::Matrix<double, 8, 1> scale_mode_px = Eigen::Matrix<double, 8, 1>::Zero();
 };
 
 // The tag's corners in its own frame, in the detector's order (AprilTag 3's).
@@ -69,7 +64,7 @@ using EdgeShifts = std::array<std::array<double, 2>, 4>;
 
 // What the noise model says about one tag's corners.
 struct CornerNoise {
-  double sigma_px = 0.1;       // each edge line fit's own noise at its ends (per edge, independent)
+  double sigma_px = 0.1;       // independent, per coordinate
   double scale_sigma_px = 0;   // the four edges' common outward error
   double edge_sigma_px = 0;    // each edge's own outward error
   double tilt_sigma_px = 0;    // each edge's own turn: its ends' opposite outward errors
@@ -89,12 +84,6 @@ std::array<cv::Point2d, 4> move_edges_in(const std::array<cv::Point2d, 4>& corne
 // other three stay: column e (0-3) when edge e moves out along its normal by 1 px, column
 // 4 + e when it turns, its start 1 px out and its end 1 px in.
 Eigen::Matrix<double, 8, 8> edge_line_modes(const std::array<cv::Point2d, 4>& corners_px);
-
-// The corners' covariance from each edge's line fit having its own noise, of unit variance
-// at each end of the edge: the line's offset takes a quarter of it and its turn three
-// quarters, so the two ends of an edge are correlated -1/2 (devices/fiducial/README.md,
-// "Corner noise model").
-Eigen::Matrix<double, 8, 8> edge_fit_noise_shape(const std::array<cv::Point2d, 4>& corners_px);
 
 // The full corner covariance of `noise` for a quad with these (corrected) corners.
 Eigen::Matrix<double, 8, 8> corner_covariance(const std::array<cv::Point2d, 4>& corners_px,
