@@ -129,12 +129,19 @@ bool scaled_square_root6(const Mat6& A, double scale, SigmaColumns& S) {
 
 SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut) {
   const double lambda = ut.alpha * ut.alpha * (kN + ut.kappa) - kN;
-  // The Cholesky factor is the cheap square root; a singular covariance (a degree of
-  // freedom known exactly) needs the eigen decomposition.
+  // Above 3 degrees the default takes the symmetric root (projection.hpp says why). It and
+  // the principal root come from the eigen decomposition; so does a Cholesky root of a
+  // singular covariance (a degree of freedom known exactly).
+  SigmaRoot kind = ut.root;
+  if (kind == SigmaRoot::automatic)
+    kind = pose.covariance.bottomRightCorner<3, 3>().trace() <= kCholeskyRootMaxRotationTraceRad2
+               ? SigmaRoot::cholesky
+               : SigmaRoot::symmetric;
   SigmaColumns S;
-  if (!scaled_square_root6(pose.covariance, kN + lambda, S)) {
+  if (kind != SigmaRoot::cholesky || !scaled_square_root6(pose.covariance, kN + lambda, S)) {
     Eigen::SelfAdjointEigenSolver<Mat6> eig((kN + lambda) * pose.covariance);
-    const Mat6 root = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+    Mat6 root = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+    if (kind == SigmaRoot::symmetric) root = root * eig.eigenvectors().transpose();
     for (int i = 0; i < kN; ++i)
       for (int j = 0; j < kLanes; ++j) S[i][j] = j < kN ? root(i, j) : 0.0;
   }
@@ -165,7 +172,8 @@ bool rotation_too_uncertain(const Mat6& C, double max_sigma_rad) {
   return std::sqrt(std::max(largest, 0.0)) > max_sigma_rad;
 }
 
-// The UT with a negative centre weight (kappa = 3 - n) can give an indefinite matrix.
+// A UT with a negative centre weight (kappa < 0, e.g. the plain 3 - n) can give an
+// indefinite matrix; the default (kappa 0) cannot, beyond rounding.
 Mat2 repair_psd(const Mat2& C, bool& repaired) {
   const double tr = C.trace(), det = C.determinant();
   if (tr >= 0 && det >= 0) return C;

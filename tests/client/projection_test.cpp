@@ -147,14 +147,28 @@ TEST(Projection, UnscentedEqualsLinearWhenTheMapIsLinear) {
   EXPECT_LT((u.mean_px - l.mean_px).norm(), 1e-3);
 }
 
-// The plain UT written out with the protocol's se3_exp: the library's sigma poses use their
-// own exp (one sin/cos pair, a series below 0.01 rad), which must be the same map.
-Mat2 reference_unscented(const Camera& cam, const UncertainPose& pose, const Vec3& p) {
-  const Mat6 S = Eigen::LLT<Mat6>(3.0 * pose.covariance).matrixL();  // n + kappa = 3
+// The UT written out with the protocol's se3_exp and Eigen's roots: the library's sigma
+// poses use their own exp (one sin/cos pair, a series below 0.01 rad) and its own 6x6
+// Cholesky factor, which must give the same.
+Mat2 reference_unscented(const Camera& cam, const UncertainPose& pose, const Vec3& p,
+                         const UnscentedParams& ut = {}) {
+  const double n_kappa = 6 + ut.kappa;  // alpha 1
+  Mat6 S;
+  const double rotation_trace = pose.covariance.bottomRightCorner<3, 3>().trace();
+  const SigmaRoot root = ut.root != SigmaRoot::automatic ? ut.root
+                         : rotation_trace <= kCholeskyRootMaxRotationTraceRad2 ? SigmaRoot::cholesky
+                                                                   : SigmaRoot::symmetric;
+  if (root == SigmaRoot::cholesky) {
+    S = Eigen::LLT<Mat6>(n_kappa * pose.covariance).matrixL();
+  } else {
+    const Eigen::SelfAdjointEigenSolver<Mat6> eig(n_kappa * pose.covariance);
+    S = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0).cwiseSqrt().asDiagonal();
+    if (root == SigmaRoot::symmetric) S = S * eig.eigenvectors().transpose();
+  }
   std::vector<Vec2> px = {cam.project(pose.T * p)};
   for (int i = 0; i < 6; ++i)
     for (double sign : {1.0, -1.0}) px.push_back(cam.project(pose.T * se3_exp(sign * S.col(i)) * p));
-  const double w0 = -1.0, wi = 1.0 / 6;  // kappa / (n + kappa), 1 / (2 (n + kappa))
+  const double w0 = ut.kappa / n_kappa, wi = 1.0 / (2 * n_kappa);
   Vec2 mean = w0 * px[0];
   for (std::size_t i = 1; i < px.size(); ++i) mean += wi * px[i];
   Mat2 cov = w0 * (px[0] - mean) * (px[0] - mean).transpose();
@@ -164,17 +178,56 @@ Mat2 reference_unscented(const Camera& cam, const UncertainPose& pose, const Vec
 
 TEST(Projection, UnscentedSigmaPosesAreTheSe3Exp) {
   const Camera cam = test::example_camera();
-  ProjectionOptions o;
-  o.add_intrinsic_uncertainty = false;
-  // 0.001 and 0.3 deg: sigma points under 0.01 rad (series); 3 and 12 deg: closed form.
-  for (double rot_deg : {0.001, 0.3, 3.0, 12.0}) {
-    const UncertainPose pose{object_pose(), covariance(0.01, rot_deg * kDeg), false};
-    for (const Vec3& p : {Vec3(0.25, -0.15, 0.2), Vec3(-0.3, 0.1, -0.1)}) {
-      const Mat2 ref = reference_unscented(cam, pose, p);
-      const ProjectedVertex v = project_vertex(cam, pose, p, o);
-      EXPECT_LT(relative_frobenius(v.covariance_px2, ref), 1e-9) << rot_deg << " deg";
+  // The default (kappa 0; Cholesky root to 3 degrees, symmetric above), the principal
+  // root, and the dissertation's plain UT (Cholesky, kappa 3 - n).
+  for (const UnscentedParams ut : {UnscentedParams{}, UnscentedParams{.root = SigmaRoot::principal},
+                                   UnscentedParams{.kappa = -3, .root = SigmaRoot::cholesky}}) {
+    ProjectionOptions o;
+    o.add_intrinsic_uncertainty = false;
+    o.unscented = ut;
+    // 0.001 and 0.3 deg: sigma points under 0.01 rad (series); 3 and 12 deg: closed form.
+    for (double rot_deg : {0.001, 0.3, 3.0, 12.0}) {
+      const UncertainPose pose{object_pose(), covariance(0.01, rot_deg * kDeg), false};
+      for (const Vec3& p : {Vec3(0.25, -0.15, 0.2), Vec3(-0.3, 0.1, -0.1)}) {
+        const Mat2 ref = reference_unscented(cam, pose, p, ut);
+        const ProjectedVertex v = project_vertex(cam, pose, p, o);
+        EXPECT_LT(relative_frobenius(v.covariance_px2, ref), 1e-9) << rot_deg << " deg, kappa " << ut.kappa;
+      }
     }
   }
+}
+
+// The defaults were chosen on the poses listed in projection.hpp; these were not among
+// them (other objects, distances and covariances).
+TEST(Projection, DefaultUnscentedHoldsOnHeldOutPosesAtTenDegrees) {
+  const Camera cam = test::example_camera();
+  ProjectionOptions o;
+  o.add_intrinsic_uncertainty = false;
+  std::mt19937_64 rng(2027);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::normal_distribution<double> normal;
+  double worst = 0, worst_plain = 0;
+  for (int trial = 0; trial < 6; ++trial) {
+    const Pose T = pose_from(Vec3(0.4 * u(rng), 0.3 * u(rng), 1.4 + 0.6 * u(rng)),
+                             Eigen::Quaterniond(Eigen::AngleAxisd(1.5 * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized())));
+    Mat6 A;
+    for (int i = 0; i < 36; ++i) A(i / 6, i % 6) = normal(rng);
+    Mat6 corr = A * A.transpose() + 1.5 * Mat6::Identity();
+    const Vec6 d = corr.diagonal().cwiseSqrt().cwiseInverse();
+    corr = d.asDiagonal() * corr * d.asDiagonal();
+    const Vec6 sigma = (Vec6() << Vec3::Constant(0.004), Vec3::Constant(10 * kDeg)).finished();
+    const UncertainPose pose{T, sigma.asDiagonal() * corr * sigma.asDiagonal(), false};
+    const Vec3 p(0.12 * u(rng), 0.12 * u(rng), 0.12 * u(rng));
+    const Mat2 mc = monte_carlo_covariance(cam, pose, p, 200'000);
+    worst = std::max(worst, relative_frobenius(project_vertex(cam, pose, p, o).covariance_px2, mc));
+    ProjectionOptions plain = o;
+    plain.unscented = {.kappa = -3, .root = SigmaRoot::cholesky};
+    worst_plain = std::max(worst_plain, relative_frobenius(project_vertex(cam, pose, p, plain).covariance_px2, mc));
+  }
+  std::printf("10 degrees, 6 held-out correlated poses: worst covariance error %.4f (plain UT %.4f)\n", worst,
+              worst_plain);
+  EXPECT_LT(worst, 0.04);  // 0.0337 measured: the 2% goal is not met (projection.hpp)
+  EXPECT_LT(worst, worst_plain);
 }
 
 TEST(Projection, ScaledUnscentedOptionIsUsed) {
@@ -247,7 +300,7 @@ TEST(Projection, BlocksGiveWhatEachVertexGetsAlone) {
     EXPECT_LT(relative_frobenius(first_order[k].covariance_px2, expected), 1e-12) << "vertex " << k;
     EXPECT_LT((first_order[k].mean_px - cam.project(pose.T * points[k])).norm(), 1e-9) << "vertex " << k;
   }
-  // And what the plain unscented transform gives, block by block.
+  // And what the unscented transform gives, block by block.
   ProjectionOptions o;
   o.add_intrinsic_uncertainty = false;
   const std::vector<ProjectedVertex> bare = project_vertices(cam, pose, points, o);

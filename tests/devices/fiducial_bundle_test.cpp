@@ -8,6 +8,9 @@
 //    its precision against its best single tag, and how rarely consistent bundles are
 //    called DEGRADED. Each frame is one random camera of the calibration's population, so
 //    frames are independent draws of the systematic corner errors.
+//  - The same renders' corner errors split by the corner model's terms (apparent scale,
+//    each edge's placement, each edge's turn) against the model's variance of each, and
+//    the apparent scale's correlation between the tags of one frame.
 //  - A board whose tag sits 2 cm from where its config says: DEGRADED, the tag named and
 //    left out, the truth inside the 99% region.
 #include <gtest/gtest.h>
@@ -246,10 +249,10 @@ TEST(FiducialBundle, NeesOfTheBundlePoseOnHeldOutRenders) {
   EXPECT_LT(sum[1] / n[1], tent_hi);
   // The tents (a non-planar object) within both bounds.
   EXPECT_GT(sum[1] / n[1], tent_lo);
-  // The boards are under-confident, about 2x (measured 3.1): the corner model's per-edge
-  // terms are larger than these renders' errors and its turn terms smaller, which a single
-  // tag's pose, dominated by its apparent size, does not show (devices/fiducial/README.md,
-  // "Tag bundles"). This bounds it at 2.5x.
+  // The boards are under-confident, about 2x (measured 2.78): the corner model puts half
+  // of its independent variance into each edge's placement, which a board's pose rests
+  // on, where these renders show 0.37x of it (ResidualsByTermOnHeldOutRenders;
+  // devices/fiducial/README.md, "Still weak"). This bounds it at 2.5x.
   EXPECT_GT(sum[0] / n[0], 6 / 2.5);
   // Consistent tags are rarely called inconsistent at the default limit.
   EXPECT_LE(degraded * 100, all * 5) << "consistent bundles DEGRADED";
@@ -310,4 +313,66 @@ TEST(FiducialBundle, ATagMovedOnTheBoardIsFoundLeftOutAndCovered) {
   EXPECT_GE(named, n * 9 / 10);
   EXPECT_GE(inside, n * 95 / 100);
   EXPECT_LT(inside_plain, n / 2) << "the moved tag must matter, or this test shows nothing";
+}
+
+// The corner residuals of the bundles' tags against their true corners, split by the
+// model's terms: each tag's 8 corner errors are exactly 4 edge offsets and 4 edge turns
+// (edge_line_modes is invertible); the offsets split into their mean (the tag's apparent
+// scale) and the rest (each edge's own placement). Each part's mean square is set against
+// the model's variance of that part (devices/fiducial/README.md, "Still weak"), and the
+// scale's correlation between tags of one frame is measured.
+TEST(FiducialBundle, ResidualsByTermOnHeldOutRenders) {
+  const CameraModel cam = test::camera(800, 600, 58);
+  struct Parts {
+    double observed[3] = {0, 0, 0}, modelled[3] = {0, 0, 0};  // scale, edge placement, turns
+    double scale_products = 0;  // over pairs of tags of one frame
+    int tags = 0, pairs = 0;
+  } parts[2];
+  for (const FrameResult& f : consistent_frames()) {
+    if (!f.bundle || f.seen.size() < 2) continue;
+    Parts& p = parts[f.tent];
+    std::vector<double> scale;
+    for (const BundleObservation& o : f.seen) {
+      const auto X = tag_corner_points(o.tag.size_m);
+      Eigen::Matrix<double, 8, 1> d;
+      for (int k = 0; k < 4; ++k) {
+        const cv::Point2d t = cam.project(f.truth * (o.tag.T_bundle_tag * X[k]));
+        d(2 * k) = o.pose.corners_px[k].x - t.x, d(2 * k + 1) = o.pose.corners_px[k].y - t.y;
+      }
+      const Eigen::Matrix<double, 8, 8> to_modes = edge_line_modes(o.pose.corners_px).inverse();
+      const Eigen::Matrix<double, 8, 1> q = to_modes * d;
+      const Eigen::Matrix<double, 8, 8> C = to_modes * o.pose.corner_covariance * to_modes.transpose();
+      const Eigen::Matrix4d rest = Eigen::Matrix4d::Identity() - Eigen::Matrix4d::Constant(0.25);
+      const Eigen::Matrix4d offsets = C.topLeftCorner<4, 4>();
+      const double s = q.head<4>().mean();
+      p.observed[0] += s * s, p.modelled[0] += offsets.sum() / 16;
+      p.observed[1] += (rest * q.head<4>()).squaredNorm(), p.modelled[1] += (rest * offsets * rest).trace();
+      p.observed[2] += q.tail<4>().squaredNorm(), p.modelled[2] += C.bottomRightCorner<4, 4>().trace();
+      scale.push_back(s);
+      ++p.tags;
+    }
+    for (std::size_t i = 0; i < scale.size(); ++i)
+      for (std::size_t j = i + 1; j < scale.size(); ++j)
+        p.scale_products += scale[i] * scale[j], ++p.pairs;
+  }
+  for (int tent = 0; tent < 2; ++tent) {
+    const Parts& p = parts[tent];
+    const double corr = (p.scale_products / p.pairs) / (p.observed[0] / p.tags);
+    std::printf("%s tags (%d): observed / modelled mean square: apparent scale %.4f / %.4f px^2 (%.2f), edge placement "
+                "%.4f / %.4f (%.2f), edge turns %.4f / %.4f (%.2f); scale correlation between tags of a frame %.2f\n",
+                tent ? "tent" : "board", p.tags, p.observed[0] / p.tags, p.modelled[0] / p.tags,
+                p.observed[0] / p.modelled[0], p.observed[1] / p.tags, p.modelled[1] / p.tags,
+                p.observed[1] / p.modelled[1], p.observed[2] / p.tags, p.modelled[2] / p.tags,
+                p.observed[2] / p.modelled[2], corr);
+    ASSERT_GT(p.tags, 100);
+    // The apparent-scale error is the frame's, not each tag's (the README's finding; the
+    // bundle's covariance does not hold it yet).
+    EXPECT_GT(corr, 0.8) << (tent ? "tent" : "board");
+    // The model's total within 2x of what these renders show: how it splits that total
+    // is what the README's figures judge.
+    const double observed = p.observed[0] + p.observed[1] + p.observed[2];
+    const double modelled = p.modelled[0] + p.modelled[1] + p.modelled[2];
+    EXPECT_GT(observed / modelled, 0.5) << (tent ? "tent" : "board");
+    EXPECT_LT(observed / modelled, 2.0) << (tent ? "tent" : "board");
+  }
 }
