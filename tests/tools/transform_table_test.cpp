@@ -112,6 +112,20 @@ TEST_F(TransformTableFiles, AMissingTableIsNamedWithTheScenesKey) {
   expect_has(s.error().message, "absent.csv");
 }
 
+// A table is bulk data: larger than a config file may be (4 MiB), it still loads.
+TEST_F(TransformTableFiles, ATableLargerThanAConfigFileLoads) {
+  std::string rows = std::string(kTransformTableHeader) + "\n";
+  const int links = 60'000;
+  for (int i = 0; i < links; ++i)
+    rows += fmt::format("f{},f{},0.001,0.002,0.003,0.1,0.2,0.3,0.0001,0.0001,0.0001,0.0001,0.0001,0.0001\n", i, i + 1);
+  ASSERT_GT(rows.size(), std::size_t(4) << 20);
+  write("big.csv", rows);
+  const std::string scene_path = write("s.toml", "transform_tables = [\"big.csv\"]\n" + std::string(kCamera));
+  auto s = scene::load_scene(scene_path);
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_EQ(s->transforms.size(), std::size_t(links));
+}
+
 TEST(TransformTable, MistakesGiveFileLineAndColumn) {
   expect_has(table_error("a,b,0,0,0,0,0,0,0,0,0,0,0\n"), "t.csv:2: 13 columns, expected 14");
   expect_has(table_error("a,b,0,0,0,0,0,0,0,0,0,0,0,0,0\n"), "t.csv:2: 15 columns, expected 14");

@@ -31,7 +31,6 @@ namespace {
 constexpr std::size_t kMaxErrorsShown = 100;
 // Configs and layouts are a few kB; a bigger "config" is something else (a FIFO fed
 // forever, a log), and reading it whole would take the daemon's memory.
-constexpr std::size_t kMaxConfigBytes = 4 << 20;
 }  // namespace
 
 void ConfigErrors::add(const std::string& file, const toml::source_region& where,
@@ -270,7 +269,7 @@ std::vector<const toml::table*> TableReader::tables(std::string_view key) {
   return out;
 }
 
-Result<std::string> read_config_text(const std::string& path) {
+Result<std::string> read_config_text(const std::string& path, std::size_t max_bytes) {
   // A pipe is read to its end, so that `--config <(make-config)` works; the daemon ends
   // on SIGINT/SIGTERM while it waits for one. A folder or a device is refused: reading
   // one can block or never end.
@@ -279,11 +278,16 @@ Result<std::string> read_config_text(const std::string& path) {
     return fail(fmt::format("{}: is {}, not a file to read", path, describe(kind)));
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(path + ": cannot read the file");
-  std::string text(kMaxConfigBytes + 1, '\0');
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
-  if (text.size() > kMaxConfigBytes)
-    return fail(fmt::format("{}: is larger than {} MiB, too large for a config file", path, kMaxConfigBytes >> 20));
+  // In chunks, so that memory grows with the file, not with the bound.
+  std::string text;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
+    text.append(chunk, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > max_bytes)
+      return fail(fmt::format("{}: is larger than {} MiB, {}", path, max_bytes >> 20,
+                              max_bytes == kMaxConfigBytes ? "too large for a config file"
+                                                           : "the most read from a file of this kind"));
+  }
   return text;
 }
 

@@ -149,7 +149,9 @@ Result<std::vector<SceneTransform>> parse_transform_table(std::string_view text,
 }
 
 Result<std::vector<SceneTransform>> load_transform_table(const std::string& path) {
-  auto text = read_config_text(path);
+  // Bulk data: about 3 million links (a row is about 80 bytes), far past a config's bound.
+  constexpr std::size_t kMaxTableBytes = std::size_t(256) << 20;
+  auto text = read_config_text(path, kMaxTableBytes);
   if (!text) return std::unexpected(text.error());
   return parse_transform_table(*text, path);
 }

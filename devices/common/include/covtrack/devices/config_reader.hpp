@@ -2,6 +2,7 @@
 // Validated reading of one TOML table against a declared schema. Every problem becomes
 // one error with file:line:column and the full key path; reading goes on so that a user
 // sees all of a config's mistakes at once. The same schema prints config/schema.md.
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -112,8 +113,11 @@ class TableReader {
   ConfigErrors& errors_;
 };
 
-// The whole text of a config file (a regular file or a pipe), or an error naming it.
-Result<std::string> read_config_text(const std::string& path);
+// Config files are small: a larger one (or an endless pipe) is refused, not read into memory.
+inline constexpr std::size_t kMaxConfigBytes = 4 << 20;
+// The whole text of a config file (a regular file or a pipe), or an error naming it. Bulk
+// data a config names (a scene's transform tables) passes a larger bound.
+Result<std::string> read_config_text(const std::string& path, std::size_t max_bytes = kMaxConfigBytes);
 // Parsed TOML, or one error "source:line:column: TOML syntax error: ...".
 Result<toml::table> parse_toml(std::string_view text, const std::string& source_name);
 
