@@ -206,27 +206,34 @@ Result<UncertainPose> TransformGraph::query(const std::string& A, const std::str
   return r->pose;
 }
 
-// What one query has evaluated: each edge once, as a value and as a linear function of the
-// errors of the edges whose errors are their own (graph_fusion.hpp).
+// What one query has evaluated: each edge once, as a value and, where a fused frame made
+// it so, as a linear function of other edges' errors (graph_fusion.hpp).
 struct TransformGraph::QueryState {
   struct Evaluated {
     UncertainPose value;
-    fusion::LinearEstimate linear;
+    // None: the edge's error is its own (value.covariance), as for every edge of a query
+    // that passes no fused frame, which thus never builds a linear form.
+    std::optional<fusion::LinearEstimate> linear;
   };
   std::int64_t now_us = 0;
   std::unordered_map<FrameIndex, Evaluated> edges;
-  std::unordered_map<FrameIndex, Mat6> own_covariance;
   std::vector<EdgeChoice> choices;
 
   fusion::EdgeCovariance covariance_of() const {
-    return [this](fusion::EdgeKey e) -> const Mat6& { return own_covariance.at(e); };
+    return [this](fusion::EdgeKey e) -> const Mat6& { return edges.at(e).value.covariance; };
   }
   // T_A_B along the path: the edges from A up, inverted, then down to B.
   fusion::LinearEstimate along(const TreePath& path) const {
+    std::vector<fusion::LinearEstimate> own;  // one-term forms of the edges without one
+    own.reserve(path.up_A.size() + path.up_B.size());  // the factors point into it
+    const auto form = [&](FrameIndex c) -> const fusion::LinearEstimate* {
+      const Evaluated& e = edges.at(c);
+      if (e.linear) return &*e.linear;
+      return &own.emplace_back(fusion::LinearEstimate{e.value.T, {{c, Mat6::Identity()}}});
+    };
     std::vector<fusion::LinearFactor> factors;
-    for (FrameIndex c : path.up_A) factors.push_back({&edges.at(c).linear, true});
-    for (auto it = path.up_B.rbegin(); it != path.up_B.rend(); ++it)
-      factors.push_back({&edges.at(*it).linear, false});
+    for (FrameIndex c : path.up_A) factors.push_back({form(c), true});
+    for (auto it = path.up_B.rbegin(); it != path.up_B.rend(); ++it) factors.push_back({form(*it), false});
     return fusion::compose(factors);
   }
 };
@@ -246,8 +253,7 @@ Result<void> TransformGraph::evaluate_edge(FrameIndex child, QueryState& state) 
   auto v = edge_value(child, state.now_us);
   if (!v) return std::unexpected(v.error());
   if (v->choice) state.choices.push_back(*v->choice);
-  state.own_covariance[child] = v->value.covariance;
-  state.edges[child] = {v->value, {v->value.T, {{child, Mat6::Identity()}}}};
+  state.edges[child] = {v->value, std::nullopt};
   return {};
 }
 
@@ -275,12 +281,9 @@ Result<void> TransformGraph::evaluate_fused(FrameIndex child, QueryState& state)
     if (!combined) return fail("transform graph: fused frame '" + frame.name + "': " + combined.error().message);
     choice = {frame.name, combined->chosen, combined->fused};
     out.value = combined->pose;
-    if (!combined->fused) {
-      out.linear = paths[combined->chosen];
-    } else {  // its correlation with the other edges is unknown: its error is its own
-      state.own_covariance[child] = out.value.covariance;
-      out.linear = {out.value.T, {{child, Mat6::Identity()}}};
-    }
+    // A fusion the combiner made has an unknown correlation with the other edges: its
+    // error counts as its own (no linear form).
+    if (!combined->fused) out.linear = paths[combined->chosen];
   } else {
     std::vector<fusion::LinearEstimate> bounded;
     std::vector<std::size_t> index_of;
@@ -291,12 +294,12 @@ Result<void> TransformGraph::evaluate_fused(FrameIndex child, QueryState& state)
       }
     if (bounded.empty()) {
       out.value = {candidates.front().T, Mat6::Zero(), true};
-      out.linear = {candidates.front().T, {}};
+      out.linear = fusion::LinearEstimate{candidates.front().T, {}};
     } else {
       std::size_t base = 0;
       out.linear = fusion::fuse(bounded, state.covariance_of(), &base);
-      const Mat6 c = fusion::covariance(out.linear, state.covariance_of());
-      out.value = {out.linear.T, 0.5 * (c + c.transpose()), false};
+      const Mat6 c = fusion::covariance(*out.linear, state.covariance_of());
+      out.value = {out.linear->T, 0.5 * (c + c.transpose()), false};
       choice = {frame.name, index_of[base], bounded.size() > 1};
     }
   }
