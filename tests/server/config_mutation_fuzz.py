@@ -220,22 +220,26 @@ def table_blocks(lines):
     return out
 
 
-def repeat_block(lines, rng):
+def pick_block(lines, rng):
+    """One [[array.of.tables]] entry, or None when the file has none."""
     blocks = table_blocks(lines)
-    if not blocks:
+    return rng.choice(blocks) if blocks else None
+
+
+def repeat_block(lines, rng):
+    block = pick_block(lines, rng)
+    if not block:
         return False
-    start, end = rng.choice(blocks)
-    times = rng.choice([1, 2, 50, 3000])
-    lines[end:end] = lines[start:end] * times
+    start, end = block
+    lines[end:end] = lines[start:end] * rng.choice([1, 2, 50, 3000])
     return True
 
 
 def drop_block(lines, rng):
-    blocks = table_blocks(lines)
-    if not blocks:
+    block = pick_block(lines, rng)
+    if not block:
         return False
-    start, end = rng.choice(blocks)
-    del lines[start:end]
+    del lines[block[0]:block[1]]
     return True
 
 
