@@ -14,12 +14,12 @@
 
 #include <Eigen/Cholesky>
 #include <opencv2/core.hpp>
-#include <osg/Image>
+#include <opencv2/imgproc.hpp>
 #include <osg/ShapeDrawable>
-#include <osgViewer/Viewer>
 
 #include "covtrack/client/regions.hpp"
 #include "covtrack/osg/ar_scene.hpp"
+#include "covtrack/osg/ar_viewer.hpp"
 #include "covtrack/osg/camera_matrices.hpp"
 
 using namespace covtrack;
@@ -56,47 +56,27 @@ osg::ref_ptr<osg::Node> coloured_box(const osg::Vec4& colour) {
   return geode;
 }
 
-// Renders the scene into a pbuffer and reads the frame back (top row first, RGB).
+// The scene drawn off screen, each frame read back as RGB (top row first).
 class OffscreenView {
  public:
   explicit OffscreenView(ar::ArScene& scene) {
-    const Camera& c = scene.camera();
-    osg::ref_ptr<osg::GraphicsContext::Traits> traits = new osg::GraphicsContext::Traits;
-    traits->width = c.width_px, traits->height = c.height_px;
-    traits->pbuffer = true;
-    traits->doubleBuffer = false;
-    traits->readDISPLAY();
-    if (traits->displayNum < 0) traits->displayNum = 0;
-    context_ = osg::GraphicsContext::createGraphicsContext(traits.get());
-    if (!context_) return;
-    viewer_.setThreadingModel(osgViewer::Viewer::SingleThreaded);
-    viewer_.getCamera()->setGraphicsContext(context_);
-    scene.configure(*viewer_.getCamera());
-    image_ = new osg::Image;
-    viewer_.getCamera()->setFinalDrawCallback(new Capture(image_, c.width_px, c.height_px));
-    viewer_.setSceneData(scene.root());
-    viewer_.realize();
+    auto viewer = ar::ArViewer::open(scene, ar::ArViewer::Output::offscreen);
+    if (viewer) viewer_ = std::move(*viewer);
+    else error_ = viewer.error().message;
   }
-  bool usable() const { return context_.valid() && viewer_.isRealized(); }
+  bool usable() const { return viewer_ != nullptr; }
+  const std::string& error() const { return error_; }
 
   cv::Mat render() {
-    viewer_.frame();
-    cv::Mat rgb(image_->t(), image_->s(), CV_8UC3, image_->data());
-    cv::Mat top_first;
-    cv::flip(rgb, top_first, 0);  // OpenGL's rows start at the bottom
-    return top_first.clone();
+    viewer_->frame();
+    cv::Mat rgb;
+    cv::cvtColor(viewer_->image(), rgb, cv::COLOR_BGR2RGB);
+    return rgb;
   }
 
  private:
-  struct Capture : osg::Camera::DrawCallback {
-    Capture(osg::Image* image, int w, int h) : image(image), w(w), h(h) {}
-    void operator()(osg::RenderInfo&) const override { image->readPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE); }
-    osg::Image* image;
-    int w, h;
-  };
-  osg::ref_ptr<osg::GraphicsContext> context_;
-  osgViewer::Viewer viewer_;
-  osg::ref_ptr<osg::Image> image_;
+  std::unique_ptr<ar::ArViewer> viewer_;
+  std::string error_;
 };
 
 bool is_red(const cv::Vec3b& p) { return p[0] > 200 && p[1] < 60 && p[2] < 60; }
@@ -179,7 +159,7 @@ TEST(ArScene, TheBoxWhereItTrulyIsLiesInsideTheOuterRegionOfTheEstimate) {
   options.draw_regions = false;  // the regions' own lines would hide the pixels judged
   ar::ArScene scene = box_scene(options);
   OffscreenView view(scene);
-  ASSERT_TRUE(view.usable()) << "no OpenGL pbuffer on DISPLAY (run under xvfb-run with Mesa)";
+  ASSERT_TRUE(view.usable()) << view.error();
   const Camera& camera = scene.camera();
   const Pose T_est = box_pose();
   const Mat6 C = box_covariance();
@@ -214,7 +194,7 @@ TEST(ArScene, TheBoxWhereItTrulyIsLiesInsideTheOuterRegionOfTheEstimate) {
 TEST(ArScene, InnerRegionIsOnTheBoxAndTheOuterRegionIsDrawnWhereItIs) {
   ar::ArScene scene = box_scene();
   OffscreenView view(scene);
-  ASSERT_TRUE(view.usable());
+  ASSERT_TRUE(view.usable()) << view.error();
   const Camera& camera = scene.camera();
   ArFrame frame;
   frame.objects.push_back(frame_of(camera, box_pose(), box_pose(), box_covariance() / 4));
@@ -252,7 +232,7 @@ TEST(ArScene, InnerRegionIsOnTheBoxAndTheOuterRegionIsDrawnWhereItIs) {
 TEST(ArScene, LevelOfErrorShowsItsLevelsSubgraphVideoFillsTheBackgroundLabelsAreDrawn) {
   ar::ArScene scene = box_scene();
   OffscreenView view(scene);
-  ASSERT_TRUE(view.usable());
+  ASSERT_TRUE(view.usable()) << view.error();
   const Camera& camera = scene.camera();
   scene.set_video(cv::Mat(48, 64, CV_8UC3, cv::Scalar(255, 0, 0)));  // BGR: blue
   int red = 0, green = 0;

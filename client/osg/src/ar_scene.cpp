@@ -184,7 +184,11 @@ void ArScene::update(const client::ArFrame& frame, std::span<const std::string> 
     if (!labelled) continue;
     const client::Box& box = o.label.box;
     text.setText(label_texts[i]);
+    // The placer sized the box for the application's own text measure: shrink the glyphs
+    // until this font's text fits it too.
     text.setCharacterSize(float(0.8 * box.height()));
+    if (const osg::BoundingBox bb = text.computeBoundingBox(); bb.valid() && bb.xMax() - bb.xMin() > box.width())
+      text.setCharacterSize(float(0.8 * box.height() * box.width() / (bb.xMax() - bb.xMin())));
     text.setPosition(osg::Vec3(float(box.min.x()), float(box.center().y()), 0));
     if (o.label.leader && options_.draw_regions) {
       const client::Vec2 leader[2] = {(*o.label.leader)[0], (*o.label.leader)[1]};
