@@ -7,6 +7,7 @@
 
 #include "covtrack/client/convex_polygon.hpp"
 #include "covtrack/client/selection.hpp"
+#include "covtrack/client/selection_session.hpp"
 
 using namespace covtrack::client;
 
@@ -208,4 +209,37 @@ TEST(TwoStepSelection, NarrowsByLikelihoodThenPicksATarget) {
   ASSERT_EQ(selection.step(), TwoStepSelection::Step::pick_object);
   EXPECT_FALSE(selection.click(pointer_with_covariance(Vec2(600, 450), Mat2::Identity()), drawers));
   EXPECT_EQ(selection.step(), TwoStepSelection::Step::pick_group);
+}
+
+// The session a user drives: preselection names what a direct click would pick; direct
+// clicks select at once; two-step lays out targets for an ambiguous click and the next
+// click on a target selects; switching technique drops the targets.
+TEST(SelectionSession, PreselectsClicksAndSwitchesTechnique) {
+  const std::vector<Selectable> objects = {{square(0, 0, 10, 10), 1.0}, {square(9, 0, 19, 10), 2.0},
+                                           {square(40, 40, 50, 50), 1.5}};
+  const auto at = [](double u, double v) { return pointer_with_covariance(Vec2(u, v), Mat2::Identity() * 0.25); };
+  SelectionSession session;
+  EXPECT_EQ(session.technique(), SelectionTechnique::two_step);
+  session.update(at(45, 45), objects);
+  EXPECT_EQ(session.preselected(), 2);
+  session.set_preselect(false);
+  session.update(at(45, 45), objects);
+  EXPECT_FALSE(session.preselected());
+
+  EXPECT_EQ(session.click(at(45, 45), objects), 2);
+  EXPECT_EQ(session.selected(), 2);
+  EXPECT_FALSE(session.click(at(9.5, 5), objects)) << "two candidates: targets first";
+  ASSERT_EQ(session.targets().size(), 2u);
+  EXPECT_EQ(session.selected(), 2) << "still the last selection";
+  const SelectionTarget second = session.targets()[1];
+  EXPECT_EQ(session.click(at(second.box.center().x(), second.box.center().y()), objects), second.object);
+  EXPECT_TRUE(session.targets().empty());
+
+  EXPECT_FALSE(session.click(at(9.5, 5), objects));
+  ASSERT_FALSE(session.targets().empty());
+  session.set_technique(SelectionTechnique::direct);
+  EXPECT_TRUE(session.targets().empty()) << "switching drops the other technique's targets";
+  EXPECT_EQ(session.click(at(9.3, 5), objects), 0) << "direct: the more likely at once";
+  EXPECT_FALSE(session.click(at(100, 100), objects));
+  EXPECT_EQ(session.selected(), 0);
 }

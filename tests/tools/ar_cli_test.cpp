@@ -5,6 +5,7 @@
 // the same scene, and each object fills its inner region. Mistakes are reported: a model
 // that is missing or unreadable, no display.
 #include <filesystem>
+#include <optional>
 #include <fstream>
 #include <string>
 
@@ -141,4 +142,55 @@ TEST_F(ArCli, MistakesAreReported) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.out.find("xvfb-run"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "c.png"));
+}
+
+// A scripted selection session (synthetic clicks through the same session the window's
+// mouse drives) on two crates side by side whose outer regions overlap: a click on one
+// crate's middle selects it; a click where both may be lays out a target each, and a
+// click on a target picks its crate; direct selection picks the more likely at once.
+TEST_F(ArCli, ScriptedClicksSelectTheIntendedCrate) {
+  const std::string scene = (dir_ / "crates.toml").string();
+  std::ofstream(scene) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR
+                          "/config/cameras/rendered_640x480.yml\"\n"
+                          "[[transform]]\nparent = \"camera\"\nchild = \"left\"\nposition_m = [-0.046, 0, 0.5]\n"
+                          "sigma_m = [0.003, 0.003, 0.003]\nsigma_rad = [0.01, 0.01, 0.01]\n"
+                          "[[transform]]\nparent = \"camera\"\nchild = \"right\"\nposition_m = [0.046, 0, 0.5]\n"
+                          "sigma_m = [0.003, 0.003, 0.003]\nsigma_rad = [0.01, 0.01, 0.01]\n"
+                          "[[object]]\nname = \"left_crate\"\nframe = \"left\"\nbox_m = [0.08, 0.06, 0.04]\n"
+                          "[[object]]\nname = \"right_crate\"\nframe = \"right\"\nbox_m = [0.08, 0.06, 0.04]\n";
+  const CliRun regions = run_covtrack("regions " + scene + " --json");
+  ASSERT_EQ(regions.exit_code, 0) << regions.out;
+  const nlohmann::json doc = nlohmann::json::parse(regions.out, nullptr, false);
+  ASSERT_FALSE(doc.is_discarded());
+  const nlohmann::json& left = doc["objects"][0]["outer_px"];
+  const nlohmann::json& right = doc["objects"][1]["outer_px"];
+  // A pixel in both outer regions, and the middle of the left crate's inner region.
+  std::optional<std::pair<int, int>> both;
+  for (int v = 0; v < 480 && !both; ++v)
+    for (int u = 0; u < 640 && !both; ++u)
+      if (json_polygon_contains(left, u, v, 0) && json_polygon_contains(right, u, v, 0)) both = {u, v};
+  ASSERT_TRUE(both) << "the crates' outer regions must overlap for this test";
+  double cu = 0, cv = 0;
+  for (const auto& p : doc["objects"][0]["inner_px"]) cu += p[0].get<double>(), cv += p[1].get<double>();
+  cu /= doc["objects"][0]["inner_px"].size(), cv /= doc["objects"][0]["inner_px"].size();
+
+  const std::string at_both = std::to_string(both->first) + "," + std::to_string(both->second);
+  const std::string png = " --png " + (dir_ / "s.png").string() + " --duration 1";
+  CliRun r = run_covtrack("ar " + scene + png + " --click " + std::to_string(cu) + "," + std::to_string(cv) +
+                          "@0.1 --click " + at_both + "@0.2 --click target:right_crate@0.3");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("selected left_crate (two-step)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("targets: pick one of 2: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("selected right_crate (two-step)"), std::string::npos) << r.out;
+  EXPECT_LT(r.out.find("selected left_crate"), r.out.find("targets:")) << "in the order clicked: " << r.out;
+
+  r = run_covtrack("ar " + scene + png + " --selection direct --click " + at_both + "@0.1 --click target:left_crate@0.2");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("(direct)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("targets:"), std::string::npos) << "direct selection lays out no targets: " << r.out;
+  EXPECT_NE(r.out.find("no target of 'left_crate' is shown"), std::string::npos) << r.out;
+
+  r = run_covtrack("ar " + scene + png + " --click 12@0.1");
+  EXPECT_EQ(r.exit_code, 2) << r.out;  // a usage error
+  EXPECT_NE(r.out.find("expected U,V@T"), std::string::npos) << r.out;
 }

@@ -16,6 +16,7 @@
 
 #include "commands.hpp"
 #include "ar_models.hpp"
+#include "ar_selection.hpp"
 #include "covtrack/osg/ar_scene.hpp"
 #include "covtrack/osg/ar_viewer.hpp"
 #include "covtrack/program/command_line.hpp"
@@ -42,6 +43,8 @@ struct ArArgs {
   double fps = 30;
   double confidence = 0;
   bool regions = true;
+  client::SelectionTechnique technique = client::SelectionTechnique::two_step;
+  std::vector<std::string> clicks;
 };
 
 int run_ar(const ArArgs& args) {
@@ -66,8 +69,16 @@ int run_ar(const ArArgs& args) {
     if (!levels) return fail_with(fmt::format("{}: {}", args.scene_path, levels.error().message), 2);
     scene.add_object(std::move(*levels));
   }
+  std::vector<ScriptedClick> script;
+  for (const std::string& text : args.clicks) {
+    auto click = parse_click(text);
+    if (!click) return fail_with(click.error().message, program::kExitUsageError);
+    script.push_back(*click);
+  }
+  osg::ref_ptr<ArSelection> selection = new ArSelection(*model, args.technique, std::move(script));
   auto viewer = ar::ArViewer::open(scene, window ? ar::ArViewer::Output::window : ar::ArViewer::Output::offscreen);
   if (!viewer) return fail_with(viewer.error().message, program::kExitRuntimeError);
+  (*viewer)->add_event_handler(selection.get());
 
   auto source = ViewSource::open(*model, args.source, "covtrack ar");
   if (!source) return fail_with(source.error().message, source.error().exit_code);
@@ -94,6 +105,8 @@ int run_ar(const ArArgs& args) {
     if (!now) return fail_with(now.error().message, 2);
     const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s - 1e-9) || src.finished();
     if (auto r = view->update(src.graph(), *now); !r) return fail_with(fmt::format("{}: {}", args.scene_path, r.error().message), 2);
+    // Every frame takes the clicks due, even those --png does not draw.
+    const ar::SelectionDrawing selected = selection->frame(view->frame(), src.graph(), *now, elapsed_s, std::cout);
     // --png takes its one frame at the end of --duration.
     if (!args.png_path.empty() && !last && duration_s > 0) continue;
 
@@ -105,7 +118,7 @@ int run_ar(const ArArgs& args) {
       warning.clear();
     }
     scene.set_video(image);
-    scene.update(frame, texts);
+    scene.update(frame, texts, &selected);
     const bool open = (*viewer)->frame();
     if (!args.png_path.empty()) {
       if (auto r = write_png((*viewer)->image(), args.png_path); !r) return fail_with(r.error().message, 1);
@@ -140,6 +153,16 @@ void add_ar_command(CLI::App& app) {
   cmd->add_option("--confidence", args->confidence, "Confidence of the regions (default: the scene's)")
       ->check(program::in_range(0.5, 0.9999));
   cmd->add_flag("!--no-regions", args->regions, "Draw the objects and labels only, not their error regions");
+  const std::map<std::string, client::SelectionTechnique> techniques = {
+      {"direct", client::SelectionTechnique::direct}, {"two-step", client::SelectionTechnique::two_step}};
+  cmd->add_option("--selection", args->technique,
+                  "direct (a click picks the most likely object) or two-step (a click on several lays out a "
+                  "target each); `t` switches in the window, `p` switches preselection")
+      ->transform(program::one_of(techniques));
+  cmd->add_option("--click", args->clicks,
+                  "A scripted click: U,V@T (the mouse at pixel U,V at scene second T), target:NAME@T (NAME's "
+                  "two-step target) or pointer@T (the scene's tracked pointer); repeat for a session. Selections "
+                  "are told on stdout");
   cmd->callback([args] {
     if (const int code = run_ar(*args); code != 0) throw CLI::RuntimeError(code);
   });

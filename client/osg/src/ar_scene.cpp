@@ -1,6 +1,7 @@
 #include "covtrack/osg/ar_scene.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <opencv2/imgproc.hpp>
@@ -30,6 +31,29 @@ osg::ref_ptr<osg::Camera> pixel_camera(const client::Camera& c, osg::Camera::Ren
   state->setMode(GL_LIGHTING, osg::StateAttribute::OFF | osg::StateAttribute::OVERRIDE);
   state->setMode(GL_DEPTH_TEST, osg::StateAttribute::OFF | osg::StateAttribute::OVERRIDE);
   return cam;
+}
+
+// Text in the overlay's pixels, hidden until set.
+osg::ref_ptr<osgText::Text> overlay_text(const osg::Vec4& colour) {
+  osg::ref_ptr<osgText::Text> text = new osgText::Text;
+  text->setDataVariance(osg::Object::DYNAMIC);
+  text->setColor(colour);
+  // The overlay's v grows downwards: the glyphs are turned over to stand upright.
+  text->setAxisAlignment(osgText::TextBase::USER_DEFINED_ROTATION);
+  text->setRotation(osg::Quat(M_PI, osg::X_AXIS));
+  text->setAlignment(osgText::TextBase::LEFT_CENTER);
+  text->setNodeMask(0);
+  return text;
+}
+
+// `text` in `box`, its glyphs as high as 0.8 of the box and shrunk until it fits.
+void put_text(osgText::Text& text, const std::string& content, const client::Box& box) {
+  text.setText(content);
+  text.setCharacterSize(float(0.8 * box.height()));
+  if (const osg::BoundingBox bb = text.computeBoundingBox(); bb.valid() && bb.xMax() - bb.xMin() > box.width())
+    text.setCharacterSize(float(0.8 * box.height() * box.width() / (bb.xMax() - bb.xMin())));
+  text.setPosition(osg::Vec3(float(box.min.x()), float(box.center().y()), 0));
+  text.setNodeMask(~0u);
 }
 
 // Line loops rebuilt every frame, in one colour.
@@ -161,9 +185,11 @@ void ArScene::build_overlay() {
   overlay_->getOrCreateStateSet()->setAttributeAndModes(new osg::LineWidth(options_.line_width_px));
   outer_lines_ = line_geometry(options_.outer_colour);
   inner_lines_ = line_geometry(options_.inner_colour);
+  selected_lines_ = line_geometry(options_.selected_colour);
+  preselected_lines_ = line_geometry(options_.preselected_colour);
+  pointer_lines_ = line_geometry(options_.pointer_colour);
   osg::ref_ptr<osg::Geode> lines = new osg::Geode;
-  lines->addDrawable(outer_lines_);
-  lines->addDrawable(inner_lines_);
+  for (osg::Geometry* g : overlay_lines()) lines->addDrawable(g);
   labels_ = new osg::Geode;
   overlay_->addChild(lines);
   overlay_->addChild(labels_);
@@ -180,16 +206,8 @@ void ArScene::add_object(std::vector<osg::ref_ptr<osg::Node>> per_level) {
   objects_->addChild(transform);
   transforms_.push_back(transform);
   switches_.push_back(levels);
-  osg::ref_ptr<osgText::Text> text = new osgText::Text;
-  text->setDataVariance(osg::Object::DYNAMIC);
-  text->setColor(options_.label_colour);
-  // The overlay's v grows downwards: the glyphs are turned over to stand upright.
-  text->setAxisAlignment(osgText::TextBase::USER_DEFINED_ROTATION);
-  text->setRotation(osg::Quat(M_PI, osg::X_AXIS));
-  text->setAlignment(osgText::TextBase::LEFT_CENTER);
-  text->setNodeMask(0);
-  labels_->addDrawable(text);
-  texts_.push_back(text);
+  texts_.push_back(overlay_text(options_.label_colour));
+  labels_->addDrawable(texts_.back());
 }
 
 void ArScene::configure(osg::Camera& viewer_camera) const {
@@ -224,9 +242,9 @@ void ArScene::set_video(const cv::Mat& frame) {
   video_quad_->setNodeMask(~0u);
 }
 
-void ArScene::update(const client::ArFrame& frame, std::span<const std::string> label_texts) {
-  clear_lines(*outer_lines_);
-  clear_lines(*inner_lines_);
+void ArScene::update(const client::ArFrame& frame, std::span<const std::string> label_texts,
+                     const SelectionDrawing* selection) {
+  for (osg::Geometry* g : overlay_lines()) clear_lines(*g);
   const std::size_t n = std::min(frame.objects.size(), transforms_.size());
   for (std::size_t i = 0; i < n; ++i) {
     const client::ArObjectFrame& o = frame.objects[i];
@@ -241,22 +259,42 @@ void ArScene::update(const client::ArFrame& frame, std::span<const std::string> 
     const bool labelled = options_.draw_labels && i < label_texts.size() && !label_texts[i].empty();
     text.setNodeMask(labelled ? ~0u : 0);
     if (!labelled) continue;
-    const client::Box& box = o.label.box;
-    text.setText(label_texts[i]);
-    // The placer sized the box for the application's own text measure: shrink the glyphs
+    // The placer sized the box for the application's own text measure: the glyphs shrink
     // until this font's text fits it too.
-    text.setCharacterSize(float(0.8 * box.height()));
-    if (const osg::BoundingBox bb = text.computeBoundingBox(); bb.valid() && bb.xMax() - bb.xMin() > box.width())
-      text.setCharacterSize(float(0.8 * box.height() * box.width() / (bb.xMax() - bb.xMin())));
-    text.setPosition(osg::Vec3(float(box.min.x()), float(box.center().y()), 0));
+    put_text(text, label_texts[i], o.label.box);
     if (o.label.leader && options_.draw_regions) {
       const client::Vec2 leader[2] = {(*o.label.leader)[0], (*o.label.leader)[1]};
       add_lines(*outer_lines_, GL_LINES, leader);
     }
   }
   for (std::size_t i = n; i < texts_.size(); ++i) texts_[i]->setNodeMask(0);
-  finish_lines(*outer_lines_);
-  finish_lines(*inner_lines_);
+  for (auto& text : target_texts_) text->setNodeMask(0);
+  if (selection) draw_selection(frame, *selection);
+  for (osg::Geometry* g : overlay_lines()) finish_lines(*g);
+}
+
+std::array<osg::Geometry*, 5> ArScene::overlay_lines() const {
+  // In drawing order: a selection's outlines over the regions.
+  return {outer_lines_.get(), inner_lines_.get(), preselected_lines_.get(), selected_lines_.get(), pointer_lines_.get()};
+}
+
+void ArScene::draw_selection(const client::ArFrame& frame, const SelectionDrawing& selection) {
+  const auto outline = [&](std::optional<int> object, osg::Geometry& lines) {
+    if (object && *object >= 0 && static_cast<std::size_t>(*object) < frame.objects.size())
+      add_lines(lines, GL_LINE_LOOP, frame.objects[static_cast<std::size_t>(*object)].regions.outer);
+  };
+  if (selection.preselected != selection.selected) outline(selection.preselected, *preselected_lines_);
+  outline(selection.selected, *selected_lines_);
+  add_lines(*pointer_lines_, GL_LINE_LOOP, selection.pointer_region);
+  for (std::size_t k = 0; k < selection.targets.size(); ++k) {
+    const client::Box& box = selection.targets[k].box;
+    add_lines(*pointer_lines_, GL_LINE_LOOP, client::box_polygon(box));
+    if (k >= target_texts_.size()) {
+      target_texts_.push_back(overlay_text(options_.pointer_colour));
+      labels_->addDrawable(target_texts_.back());
+    }
+    if (k < selection.target_names.size()) put_text(*target_texts_[k], selection.target_names[k], box);
+  }
 }
 
 }  // namespace covtrack::ar

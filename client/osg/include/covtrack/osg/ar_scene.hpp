@@ -14,6 +14,8 @@
 // Without distortion the viewer's own camera draws the objects: configure() sets it to the
 // calibration's projection and the OpenCV camera frame (camera_matrices.hpp), and leaves
 // the colour buffer to the background.
+#include <array>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -28,14 +30,28 @@
 
 #include "covtrack/client/ar_view.hpp"
 #include "covtrack/client/camera.hpp"
+#include "covtrack/client/selection.hpp"
 
 namespace covtrack::ar {
+
+// What selection shows this frame (client::SelectionSession gives it): the selected and
+// the preselected object's outer region, the pointer's region, and the targets of a
+// two-step selection with their names.
+struct SelectionDrawing {
+  std::optional<int> selected, preselected;
+  client::Polygon pointer_region;
+  std::vector<client::SelectionTarget> targets;
+  std::vector<std::string> target_names;  // one per target
+};
 
 struct ArSceneOptions {
   double near_m = 0.01, far_m = 100;       // depths the 3-D drawing keeps
   osg::Vec4 outer_colour{1, 0.8f, 0, 1};   // RGBA
   osg::Vec4 inner_colour{0, 0.9f, 1, 1};
   osg::Vec4 label_colour{1, 1, 1, 1};
+  osg::Vec4 selected_colour{0.2f, 1, 0.3f, 1};
+  osg::Vec4 preselected_colour{1, 1, 1, 1};
+  osg::Vec4 pointer_colour{1, 0.3f, 1, 1};
   osg::Vec4 clear_colour{0, 0, 0, 1};      // behind everything until a video frame is set
   float line_width_px = 2;
   bool draw_regions = true;
@@ -59,8 +75,10 @@ class ArScene {
   void set_video(const cv::Mat& frame);
 
   // Copies one frame of ArView into the scene. `label_texts`: one per object (empty: no
-  // label text). Objects beyond those added are ignored.
-  void update(const client::ArFrame& frame, std::span<const std::string> label_texts = {});
+  // label text). Objects beyond those added are ignored. `selection`, if given, is drawn
+  // over the regions.
+  void update(const client::ArFrame& frame, std::span<const std::string> label_texts = {},
+              const SelectionDrawing* selection = nullptr);
 
   osg::Group* root() const { return root_.get(); }
   const client::Camera& camera() const { return camera_; }
@@ -76,8 +94,12 @@ class ArScene {
   osg::ref_ptr<osg::Camera> background_, lens_, overlay_;
   osg::ref_ptr<osg::Texture2D> video_;
   osg::ref_ptr<osg::Geometry> video_quad_;
-  osg::ref_ptr<osg::Geometry> outer_lines_, inner_lines_;
+  void draw_selection(const client::ArFrame& frame, const SelectionDrawing& selection);
+  std::array<osg::Geometry*, 5> overlay_lines() const;
+
+  osg::ref_ptr<osg::Geometry> outer_lines_, inner_lines_, selected_lines_, preselected_lines_, pointer_lines_;
   osg::ref_ptr<osg::Geode> labels_;
+  std::vector<osg::ref_ptr<osgText::Text>> target_texts_;  // grown as targets need
   std::vector<osg::ref_ptr<osg::MatrixTransform>> transforms_;
   std::vector<osg::ref_ptr<osg::Switch>> switches_;
   std::vector<osg::ref_ptr<osgText::Text>> texts_;

@@ -21,6 +21,9 @@ class ArViewer {
   // Fails, saying how to get one, when there is no display or no OpenGL context.
   static Result<std::unique_ptr<ArViewer>> open(ArScene& scene, Output output, const std::string& title = "covtrack ar");
 
+  // Input for the window's mouse and keys (handled while frame() runs).
+  void add_event_handler(osgGA::GUIEventHandler* handler) { viewer_.addEventHandler(handler); }
+
   // Draws one frame; false once the window is closed (or Esc pressed in it).
   bool frame();
   // The frame last drawn: 8-bit BGR, top row first, the camera's size.
