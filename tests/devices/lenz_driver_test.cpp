@@ -47,18 +47,6 @@ const std::vector<SpeedStep> kProfile{{0.5, 1.5}, {0.15, 1}, {0, 1}, {0.4, 1.5}}
 // reads it in that step or the next), well within the 50 ms the dead reckoning allows.
 constexpr auto kStep = 5ms;
 
-// Moves `clock` on by `how_long` in steps, each time until `loops` loops have caught up.
-bool run_for(test::ManualClock& clock, int loops, DriverClock::duration how_long) {
-  for (DriverClock::duration done{0}; done < how_long; done += kStep) {
-    clock.advance(kStep);
-    if (!clock.settle(loops)) {
-      ADD_FAILURE() << "driver or emulator did not catch up with the simulated clock at " << clock.elapsed_s() << " s";
-      return false;
-    }
-  }
-  return true;
-}
-
 struct Rig {
   explicit Rig(Interface interface, const std::string& name) {
     LenzEmulatorOptions options;
@@ -70,6 +58,7 @@ struct Rig {
     auto created = LenzEmulator::create(options, clock);
     EXPECT_TRUE(created) << created.error().message;
     emulator = std::move(*created);
+    clock.join();
     emulator_thread = std::jthread([this](std::stop_token stop) { emulator->run(stop, nullptr); });
 
     config.device = "train";
@@ -83,20 +72,19 @@ struct Rig {
     config.no_valid_frames_s = 1.0;
     config.reconnect_s = 0.1;
     driver = make_lenz_driver(config, clock);
+    clock.join();
     driver_thread = std::jthread([this](std::stop_token stop) {
       result = driver->run(sink, stop);
       returned = true;
-      clock.left();
+      clock.leave();
     });
-    EXPECT_TRUE(clock.settle(2)) << "driver or emulator did not start";
+    EXPECT_TRUE(clock.settle()) << "driver or emulator did not start";
   }
   ~Rig() {
     driver_thread.request_stop();
     driver_thread.join();
     emulator_thread.request_stop();
   }
-  // Runs driver and emulator for `how_long` of simulated time.
-  bool run_for(DriverClock::duration how_long) { return ::run_for(clock, 2, how_long); }
   std::vector<PoseSample> poses() {
     std::lock_guard lock(sink.m);
     return sink.poses;
@@ -106,7 +94,7 @@ struct Rig {
     return sink.raw_bytes;
   }
 
-  test::ManualClock clock;  // first: outlives the threads that wait on it
+  test::ManualClock clock{kStep};  // first: outlives the threads that wait on it
   std::unique_ptr<LenzEmulator> emulator;
   LenzConfig config;
   std::unique_ptr<Driver> driver;
@@ -169,7 +157,7 @@ Honesty honesty_of(const std::vector<PoseSample>& poses, const LenzEmulator& emu
 
 TEST(LenzDriver, UncertaintyContainsTheTruthOverSpeedChangesAndAStop) {
   Rig rig(Interface::Li101f, "honesty");
-  ASSERT_TRUE(rig.run_for(9s));
+  ASSERT_TRUE(rig.clock.run_for(9s));
   const auto poses = rig.poses();
   const TrackLayout& layout = rig.emulator->layout();
   std::set<std::string> sensors;
@@ -202,7 +190,7 @@ TEST(LenzDriver, ForgedFeedbackNamingAFarSectionIsAskedAgainAndDropped) {
   int forged = 0;
   std::mt19937 rng(7);
   while (rig.clock.elapsed_s() < 9.0) {
-    ASSERT_TRUE(rig.run_for(150ms));  // paces the noise
+    ASSERT_TRUE(rig.clock.run_for(150ms));  // paces the noise
     const std::size_t here = layout.section_at(rig.emulator->true_s_at(rig.clock.now_us()));
     const std::size_t far = (here + 3 + rng() % (n - 5)) % n;  // neither neighbour, nor here
     const auto& in = layout.sections()[far].input;
@@ -212,7 +200,7 @@ TEST(LenzDriver, ForgedFeedbackNamingAFarSectionIsAskedAgainAndDropped) {
                                   static_cast<std::uint8_t>(0x40 | (upper ? 0x10 : 0) | bit)});
     ++forged;
   }
-  ASSERT_TRUE(rig.run_for(150ms));  // the last forged change is asked for again too
+  ASSERT_TRUE(rig.clock.run_for(150ms));  // the last forged change is asked for again too
   const Honesty h = honesty_of(rig.poses(), *rig.emulator);
   ASSERT_GT(h.degraded, 300);
   EXPECT_GE(h.inside_share(), 0.99);
@@ -227,7 +215,7 @@ TEST(LenzDriver, ForgedFeedbackNamingAFarSectionIsAskedAgainAndDropped) {
 
 TEST(LenzDriver, LiUsbPrefixesBothWays) {
   Rig rig(Interface::LiUsb, "liusb");
-  ASSERT_TRUE(rig.run_for(2s));
+  ASSERT_TRUE(rig.clock.run_for(2s));
   const auto poses = rig.poses();
   const auto degraded = std::count_if(poses.begin(), poses.end(),
                                       [](const PoseSample& p) { return p.status == TrackingStatus::Degraded; });
@@ -242,13 +230,13 @@ TEST(LenzDriver, LiUsbPrefixesBothWays) {
 
 TEST(LenzDriver, PortClosedMidRunGoesLostAndResumesOnReopen) {
   Rig rig(Interface::Li101f, "unplug");
-  ASSERT_TRUE(rig.run_for(1500ms));
+  ASSERT_TRUE(rig.clock.run_for(1500ms));
   const std::int64_t unplugged_us = rig.clock.now_us();
   rig.emulator->unplug();
-  ASSERT_TRUE(rig.run_for(2500ms));
+  ASSERT_TRUE(rig.clock.run_for(2500ms));
   const std::int64_t replugged_us = rig.clock.now_us();
   rig.emulator->replug();
-  ASSERT_TRUE(rig.run_for(2000ms));
+  ASSERT_TRUE(rig.clock.run_for(2000ms));
   const auto poses = rig.poses();
   const std::int64_t step_us = std::chrono::microseconds(kStep).count();
   const auto period_us = std::llround(1e6 / rig.config.rate_hz);
@@ -312,16 +300,17 @@ TEST(LenzDriver, LineOfPureNoiseFailsWithNoValidFrames) {
   config.keepalive_s = 0.2;
   config.link_timeout_s = 1.0;
   config.no_valid_frames_s = 1.0;
-  test::ManualClock clock;
+  test::ManualClock clock{kStep};
   auto driver = make_lenz_driver(config, clock);
   test::CaptureSink sink;
   std::promise<Result<void>> ended;
   auto result = ended.get_future();
+  clock.join();
   std::jthread driver_thread([&](std::stop_token stop) {
     ended.set_value(driver->run(sink, stop));
-    clock.left();
+    clock.leave();
   });
-  ASSERT_TRUE(clock.settle(1)) << "the driver did not start";
+  ASSERT_TRUE(clock.settle()) << "the driver did not start";
 
   // 100 bytes a 5 ms step, about 20 kB/s: ten times what an LI101F at 19200 baud can
   // send; the driver's requests are drained so that its writes never block.
@@ -332,7 +321,7 @@ TEST(LenzDriver, LineOfPureNoiseFailsWithNoValidFrames) {
     while (pty->read_some(drained, 0ms).value_or(0) > 0) {}
     for (auto& b : noise) b = static_cast<std::uint8_t>(rng());
     noise_bytes += pty->write(noise).value_or(0);
-    ASSERT_TRUE(run_for(clock, 1, kStep));
+    ASSERT_TRUE(clock.run_for(kStep));
   }
   ASSERT_EQ(result.wait_for(0s), std::future_status::ready) << "the driver never failed on 20 s of noise";
   const double took_s = clock.elapsed_s();

@@ -5,13 +5,16 @@
 // A loop waiting on this clock (io_timeout with nothing due, or sleep_until) blocks until
 // the time moves, so each move runs every loop at least once, and a loop blocks only
 // once it has done all the work due by then. settle() waits for that: after advance()
-// and settle(n), each of the n loops has caught up with the new time. Bytes a loop sent
-// within a step may reach the other side in that step or in the next one, as a real
-// line delivers them a little later; a step shorter than the latency a driver allows
-// for keeps that harmless.
+// and settle(), every loop that join()ed has caught up with the new time. Bytes a loop
+// sent within a step may reach the other side in that step or in the next one, as a
+// real line delivers them a little later; a step shorter than the latency a driver
+// allows for keeps that harmless.
+#include <gtest/gtest.h>
+
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 
 #include "covtrack/devices/driver_clock.hpp"
@@ -20,6 +23,8 @@ namespace covtrack::test {
 
 class ManualClock final : public DriverClock {
  public:
+  explicit ManualClock(duration step = std::chrono::milliseconds(5)) : step_(step) {}
+
   // Midnight UTC, 1 January 2026: a fixed wire time, so runs repeat exactly.
   static constexpr std::int64_t kStartUs = 1'767'225'600'000'000;
 
@@ -54,24 +59,55 @@ class ManualClock final : public DriverClock {
     cv_.notify_all();
   }
 
-  // Waits until `loops` loops wait on this clock at its current time (each has done
-  // what was due), counting those that left(). False after `timeout` of real time.
-  bool settle(int loops, std::chrono::seconds timeout = std::chrono::seconds(30)) {
+  // Waits until every joined loop waits on this clock at its current time (each has
+  // done what was due). False after `timeout` of real time.
+  bool settle(std::chrono::seconds timeout = std::chrono::seconds(30)) {
     std::unique_lock lock(m_);
-    return cv_.wait_for(lock, timeout, [&] { return idle_ + left_ >= loops; });
+    return cv_.wait_for(lock, timeout, [&] { return idle_ >= loops_; });
   }
 
-  // A loop that will not wait on this clock again (its thread returned).
-  void left() {
+  // A loop settle() waits for: join() before its thread starts, leave() when it returns.
+  void join() {
+    std::lock_guard lock(m_);
+    ++loops_;
+  }
+  void leave() {
     {
       std::lock_guard lock(m_);
-      ++left_;
+      --loops_;
     }
     cv_.notify_all();
   }
 
+  // Moves time on by `how_long` in steps, letting every loop catch up after each.
+  bool run_for(duration how_long) {
+    for (duration done{0}; done < how_long; done += step_)
+      if (!step()) return false;
+    return true;
+  }
+  // Moves time on in steps until `done` holds; false if it does not within `limit`.
+  bool run_until(const std::function<bool()>& done, duration limit) {
+    const time_point end = now() + limit;
+    while (!done()) {
+      if (now() >= end) {
+        ADD_FAILURE() << "still waiting after " << elapsed_s() << " s of simulated time";
+        return false;
+      }
+      if (!step()) return false;
+    }
+    return true;
+  }
+  duration step_length() const { return step_; }
+
  private:
   static constexpr time_point kStart = time_point(std::chrono::hours(1));
+
+  bool step() {
+    advance(step_);
+    if (settle()) return true;
+    ADD_FAILURE() << "a loop did not catch up with the simulated clock at " << elapsed_s() << " s";
+    return false;
+  }
 
   void wait_for_a_move(std::unique_lock<std::mutex>& lock, std::stop_token stop) {
     const std::uint64_t entered = moves_;
@@ -84,8 +120,9 @@ class ManualClock final : public DriverClock {
   mutable std::mutex m_;
   std::condition_variable_any cv_;
   time_point now_ = kStart;
+  const duration step_;
   std::uint64_t moves_ = 0;
-  int idle_ = 0, left_ = 0;
+  int idle_ = 0, loops_ = 0;
 };
 
 }  // namespace covtrack::test

@@ -14,7 +14,7 @@ class RealClock final : public DriverClock {
   std::int64_t now_us() const override { return covtrack::now_us(); }
   std::chrono::milliseconds io_timeout(std::stop_token, time_point due, std::chrono::milliseconds cap) override {
     using std::chrono::milliseconds;
-    return std::clamp(std::chrono::duration_cast<milliseconds>(due - now()), milliseconds(0), cap);
+    return std::max(milliseconds(0), std::min(std::chrono::duration_cast<milliseconds>(due - now()), cap));
   }
   bool sleep_until(std::stop_token stop, time_point deadline) override { return covtrack::sleep_until(stop, deadline); }
 };
