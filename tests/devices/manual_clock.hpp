@@ -97,7 +97,6 @@ class ManualClock final : public DriverClock {
     }
     return true;
   }
-  duration step_length() const { return step_; }
 
  private:
   static constexpr time_point kStart = time_point(std::chrono::hours(1));

@@ -14,7 +14,9 @@ class RealClock final : public DriverClock {
   std::int64_t now_us() const override { return covtrack::now_us(); }
   std::chrono::milliseconds io_timeout(std::stop_token, time_point due, std::chrono::milliseconds cap) override {
     using std::chrono::milliseconds;
-    return std::max(milliseconds(0), std::min(std::chrono::duration_cast<milliseconds>(due - now()), cap));
+    // Rounded up: rounded down, a wait of a fraction of a millisecond would be 0 and the
+    // loop would spin on its port until the work is due.
+    return std::max(milliseconds(0), std::min(std::chrono::ceil<milliseconds>(due - now()), cap));
   }
   bool sleep_until(std::stop_token stop, time_point deadline) override { return covtrack::sleep_until(stop, deadline); }
 };
