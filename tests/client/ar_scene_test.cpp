@@ -154,20 +154,30 @@ TEST(ArSceneMatrices, OpenGlPutsAPointWhereTheCameraModelDoes) {
   EXPECT_NEAR((Vec3(Z.x(), Z.y(), Z.z()) - Y).norm(), 0, 1e-12);
 }
 
-TEST(ArScene, TheBoxWhereItTrulyIsLiesInsideTheOuterRegionOfTheEstimate) {
+namespace {
+
+struct Containment {
+  int inside = 0;                // draws whose silhouette lies inside the 99% outer region
+  int inside_overconfident = 0;  // the same against regions of a covariance 100x too small
+  double red = 0;                // pixels of the box per draw
+};
+
+// The box drawn by `drawn` where it truly is, at kDraws poses drawn from the estimate's
+// covariance, judged against the estimate's regions through `camera`.
+constexpr int kDraws = 40;
+Containment containment(const Camera& camera, const Pose& T_est, const Camera& drawn) {
   ar::ArSceneOptions options;
   options.draw_regions = false;  // the regions' own lines would hide the pixels judged
-  ar::ArScene scene = box_scene(options);
+  ar::ArScene scene(drawn, options);
+  scene.add_object({coloured_box(osg::Vec4(1, 0, 0, 1))});
   OffscreenView view(scene);
-  ASSERT_TRUE(view.usable()) << view.error();
-  const Camera& camera = scene.camera();
-  const Pose T_est = box_pose();
+  EXPECT_TRUE(view.usable()) << view.error();
+  if (!view.usable()) return {};
   const Mat6 C = box_covariance();
   const Eigen::Matrix<double, 6, 6> L = C.llt().matrixL();
   std::mt19937_64 rng(7);
   std::normal_distribution<double> gauss;
-  constexpr int kDraws = 40;
-  int inside = 0, inside_overconfident = 0, red_total = 0;
+  Containment out;
   for (int i = 0; i < kDraws; ++i) {
     Vec6 z;
     for (int k = 0; k < 6; ++k) z(k) = gauss(rng);
@@ -177,18 +187,43 @@ TEST(ArScene, TheBoxWhereItTrulyIsLiesInsideTheOuterRegionOfTheEstimate) {
     scene.update(frame);
     const cv::Mat image = view.render();
     int red = 0;
-    inside += silhouette_inside(image, frame.objects[0].regions.outer, &red);
-    red_total += red;
-    // The same truth judged against regions 100x too confident.
-    const Polygon narrow = frame_of(camera, truth, T_est, C / 100).regions.outer;
-    inside_overconfident += silhouette_inside(image, narrow);
+    out.inside += silhouette_inside(image, frame.objects[0].regions.outer, &red);
+    out.red += double(red) / kDraws;
+    out.inside_overconfident += silhouette_inside(image, frame_of(camera, truth, T_est, C / 100).regions.outer);
   }
+  return out;
+}
+
+}  // namespace
+
+TEST(ArScene, TheBoxWhereItTrulyIsLiesInsideTheOuterRegionOfTheEstimate) {
+  const Containment c = containment(test_camera(), box_pose(), test_camera());
   std::printf("box silhouette inside the 99%% outer region in %d of %d draws (%.0f red pixels each); with a "
               "covariance 100x too small: %d\n",
-              inside, kDraws, double(red_total) / kDraws, inside_overconfident);
-  EXPECT_GT(red_total / kDraws, 1000) << "the box must be drawn, and large";
-  EXPECT_GE(inside, kDraws - 3);
-  EXPECT_LE(inside_overconfident, kDraws / 2) << "the test must be able to fail";
+              c.inside, kDraws, c.red, c.inside_overconfident);
+  EXPECT_GT(c.red, 1000) << "the box must be drawn, and large";
+  EXPECT_GE(c.inside, kDraws - 3);
+  EXPECT_LE(c.inside_overconfident, kDraws / 2) << "the test must be able to fail";
+}
+
+// Near the corner of a barrel-distorted image the lens moves the box by some 20 px: drawn
+// through the lens warp it stays inside the regions of the full lens model; drawn through
+// the pinhole alone (no warp) it does not.
+TEST(ArScene, ThroughADistortingLensTheBoxStaysInsideItsRegions) {
+  Camera camera = test_camera();
+  camera.k1 = -0.5, camera.k2 = 0.1, camera.p1 = 0.002, camera.p2 = -0.001;
+  Camera pinhole = camera;
+  pinhole.k1 = pinhole.k2 = pinhole.p1 = pinhole.p2 = 0;
+  Pose T = box_pose();
+  T.translation() = Vec3(-0.2, -0.12, 0.45);  // near the top-left corner
+  const Containment c = containment(camera, T, camera);
+  const Containment unwarped = containment(camera, T, pinhole);
+  std::printf("distorting lens: inside the 99%% outer region in %d of %d draws (%.0f red pixels each); drawn "
+              "without the lens: %d\n",
+              c.inside, kDraws, c.red, unwarped.inside);
+  EXPECT_GT(c.red, 500);
+  EXPECT_GE(c.inside, kDraws - 3);
+  EXPECT_LE(unwarped.inside, kDraws / 2) << "the lens must matter here, or this test shows nothing";
 }
 
 TEST(ArScene, InnerRegionIsOnTheBoxAndTheOuterRegionIsDrawnWhereItIs) {

@@ -28,12 +28,13 @@ class ArCli : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
-  // A scene of a stylus (the shipped model) and a crate (its hull), seen by the pinhole
-  // camera of the fiducial emulator; `model` replaces the stylus's model path.
-  std::string write_scene(const std::string& model = COVTRACK_SOURCE_DIR "/config/models/stylus.obj") {
+  // A scene of a stylus (the shipped model) and a crate (its hull), seen by `camera` (in
+  // config/cameras); `model` replaces the stylus's model path.
+  std::string write_scene(const std::string& model = COVTRACK_SOURCE_DIR "/config/models/stylus.obj",
+                          const std::string& camera = "rendered_640x480.yml") {
     const std::string path = (dir_ / "scene.toml").string();
-    std::ofstream(path) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR
-                           "/config/cameras/rendered_640x480.yml\"\nconfidence = 0.95\n"
+    std::ofstream(path) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR "/config/cameras/"
+                        << camera << "\"\nconfidence = 0.95\n"
                            "[[transform]]\nparent = \"world\"\nchild = \"camera\"\n"
                            "sigma_m = [0.001, 0.001, 0.001]\nsigma_rad = [0.002, 0.002, 0.002]\n"
                            "[[transform]]\nparent = \"world\"\nchild = \"tool\"\nposition_m = [0.03, 0.02, 0.3]\n"
@@ -62,42 +63,47 @@ bool coloured(const cv::Vec3b& p) {
 
 }  // namespace
 
+// Through the fiducial emulator's pinhole camera, and through the example calibration's
+// lens (barrel distortion, drawn through covtrack_osg's lens warp).
 TEST_F(ArCli, DrawnObjectsLieInsideTheirOuterRegionsAndFillTheirInnerOnes) {
-  const std::string scene = write_scene();
-  const std::string png = (dir_ / "ar.png").string();
-  const CliRun r = run_covtrack("ar " + scene + " --no-regions --background '#000000' --png " + png);
-  ASSERT_EQ(r.exit_code, 0) << r.out;
-  const cv::Mat image = cv::imread(png);
-  ASSERT_FALSE(image.empty());
-  ASSERT_EQ(image.cols, 640);
-  ASSERT_EQ(image.rows, 480);
+  for (const char* camera : {"rendered_640x480.yml", "example_640x480.yml"}) {
+    SCOPED_TRACE(camera);
+    const std::string scene = write_scene(COVTRACK_SOURCE_DIR "/config/models/stylus.obj", camera);
+    const std::string png = (dir_ / "ar.png").string();
+    const CliRun r = run_covtrack("ar " + scene + " --no-regions --background '#000000' --png " + png);
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const cv::Mat image = cv::imread(png);
+    ASSERT_FALSE(image.empty());
+    ASSERT_EQ(image.cols, 640);
+    ASSERT_EQ(image.rows, 480);
 
-  const CliRun regions = run_covtrack("regions " + scene + " --json");
-  ASSERT_EQ(regions.exit_code, 0) << regions.out;
-  const nlohmann::json doc = nlohmann::json::parse(regions.out, nullptr, false);
-  ASSERT_FALSE(doc.is_discarded()) << regions.out;
-  ASSERT_EQ(doc["objects"].size(), 2u);
+    const CliRun regions = run_covtrack("regions " + scene + " --json");
+    ASSERT_EQ(regions.exit_code, 0) << regions.out;
+    const nlohmann::json doc = nlohmann::json::parse(regions.out, nullptr, false);
+    ASSERT_FALSE(doc.is_discarded()) << regions.out;
+    ASSERT_EQ(doc["objects"].size(), 2u);
 
-  int drawn = 0, outside = 0;
-  for (int v = 0; v < image.rows; ++v)
-    for (int u = 0; u < image.cols; ++u) {
-      if (!coloured(image.at<cv::Vec3b>(v, u))) continue;
-      ++drawn;
-      bool inside = false;
-      for (const auto& o : doc["objects"]) inside = inside || json_polygon_contains(o["outer_px"], u, v, 1.0);
-      outside += !inside;
-    }
-  EXPECT_GT(drawn, 2000) << "both objects must be drawn";
-  EXPECT_EQ(outside, 0) << "of " << drawn << " object pixels";
-
-  for (const auto& o : doc["objects"]) {
-    int inner = 0, filled = 0;
+    int drawn = 0, outside = 0;
     for (int v = 0; v < image.rows; ++v)
-      for (int u = 0; u < image.cols; ++u)
-        if (json_polygon_contains(o["inner_px"], u, v, -2.0)) ++inner, filled += coloured(image.at<cv::Vec3b>(v, u));
-    EXPECT_GT(inner, 100) << o["name"];
-    // The label's white text covers some of it.
-    EXPECT_GT(filled, inner * 7 / 10) << o["name"];
+      for (int u = 0; u < image.cols; ++u) {
+        if (!coloured(image.at<cv::Vec3b>(v, u))) continue;
+        ++drawn;
+        bool inside = false;
+        for (const auto& o : doc["objects"]) inside = inside || json_polygon_contains(o["outer_px"], u, v, 1.0);
+        outside += !inside;
+      }
+    EXPECT_GT(drawn, 2000) << "both objects must be drawn";
+    EXPECT_EQ(outside, 0) << "of " << drawn << " object pixels";
+
+    for (const auto& o : doc["objects"]) {
+      int inner = 0, filled = 0;
+      for (int v = 0; v < image.rows; ++v)
+        for (int u = 0; u < image.cols; ++u)
+          if (json_polygon_contains(o["inner_px"], u, v, -2.0)) ++inner, filled += coloured(image.at<cv::Vec3b>(v, u));
+      EXPECT_GT(inner, 100) << o["name"];
+      // The label's white text covers some of it.
+      EXPECT_GT(filled, inner * 7 / 10) << o["name"];
+    }
   }
 }
 

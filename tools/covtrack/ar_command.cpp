@@ -3,13 +3,11 @@
 // OpenSceneGraph adapter, covtrack::ar::ArScene). Poses come from the scene's values, the
 // daemon's streams (--live) or a recording (--log), as for `covtrack view`. Output: a
 // window, or one PNG (--png) or a video (--video) drawn off screen.
-#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <opencv2/videoio.hpp>
@@ -26,6 +24,7 @@
 #include "scene_ar_view.hpp"
 #include "stop_signal.hpp"
 #include "view_background.hpp"
+#include "view_clock.hpp"
 #include "view_labels.hpp"
 #include "view_source.hpp"
 #include "view_video.hpp"
@@ -51,10 +50,8 @@ int run_ar(const ArArgs& args) {
     return code;
   };
   const bool window = args.png_path.empty() && args.video_path.empty();
-  std::optional<VideoFormat> video_format;
-  if (!args.video_path.empty() && !(video_format = video_format_for(args.video_path)))
-    return fail_with(fmt::format("--video {}: name it .mp4 (H.264) or .webm (VP9), formats browsers play",
-                                 args.video_path), program::kExitUsageError);
+  const auto video_format = args.video_path.empty() ? Result<VideoFormat>{} : video_format_for(args.video_path);
+  if (!video_format) return fail_with(video_format.error().message, program::kExitUsageError);
   const auto model = load_regions_model(args.scene_path, args.confidence);
   if (!model) return fail_with(model.error().message, 2);
   const cv::Size size(model->camera.width_px, model->camera.height_px);
@@ -87,19 +84,12 @@ int run_ar(const ArArgs& args) {
 
   install_stop_signals();
   src.announce();
-  // As `covtrack view`: a video of a log covers all of it, else 10 s; offline into a file
-  // frames are drawn at their scene or log times without waiting.
+  // As `covtrack view`: a video of a log covers all of it, else 10 s.
   const double duration_s = args.duration_s > 0 ? args.duration_s : (video && !src.log() ? 10.0 : 0.0);
-  const bool virtual_clock = !src.live() && !window;
-  const auto start = std::chrono::steady_clock::now();
-  const auto period = std::chrono::duration<double>(1.0 / args.fps);
+  const ViewClock clock(args.fps, !src.live() && !window);
   std::vector<std::string> texts(model->scene.objects.size());
   for (long frame_index = 0;; ++frame_index) {
-    double elapsed_s = frame_index * period.count();
-    if (!virtual_clock) {
-      std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(frame_index * period));
-      elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    }
+    const double elapsed_s = clock.frame_time_s(frame_index);
     const auto now = src.advance(elapsed_s);
     if (!now) return fail_with(now.error().message, 2);
     const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s - 1e-9) || src.finished();
@@ -109,11 +99,7 @@ int run_ar(const ArArgs& args) {
 
     const client::ArFrame& frame = view->frame();
     for (std::size_t i = 0; i < texts.size(); ++i) texts[i] = label_text(model->scene.objects[i].name, frame.objects[i].regions);
-    // A log's own camera frames are the background unless --background names another.
-    cv::Mat image;
-    if (src.log() && args.background.empty())
-      if (const cv::Mat& f = src.log()->image(warning); !f.empty()) image = fit_to_view(f, size);
-    if (image.empty()) image = background.next(warning);
+    cv::Mat image = src.picture(background, args.background.empty(), size, warning);
     if (!warning.empty()) {
       std::cerr << "covtrack ar: " << warning << "\n";
       warning.clear();
@@ -140,12 +126,7 @@ void add_ar_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("ar", "Draw the objects in 3-D over the camera view, with their error regions");
   cmd->add_option("SCENE", args->scene_path, "Scene file (config/scene_schema.md); an object's `model` is its 3-D model")
       ->required();
-  cmd->add_flag("--live", args->source.live, "Tracked transforms from the daemon's streams, not the scene's values");
-  cmd->add_option("--lcm-url,-u", args->source.lcm_url, "LCM URL for --live (default: $LCM_DEFAULT_URL or LCM's)");
-  cmd->add_option("--log", args->source.log_path, "Follow a recorded session (LCM log) at its own time");
-  cmd->add_option("--speed,-s", args->source.speed, "Speed factor of --log")
-      ->capture_default_str()
-      ->check(program::in_range(0.01, 1000.0));
+  add_view_source_options(*cmd, args->source);
   cmd->add_option("--png", args->png_path, "Draw off screen, write one frame (at the end of --duration, if given) and exit");
   cmd->add_option("--video", args->video_path, "Draw off screen into this video file: FILE.mp4 (H.264) or FILE.webm (VP9)");
   cmd->add_option("--background", args->background,

@@ -4,7 +4,6 @@
 // latency shows as error. Output: a window when a display exists, else one PNG (--png)
 // or a video (--video).
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <functional>
@@ -12,7 +11,6 @@
 #include <map>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <opencv2/highgui.hpp>
@@ -27,6 +25,7 @@
 #include "regions_report.hpp"
 #include "stop_signal.hpp"
 #include "view_background.hpp"
+#include "view_clock.hpp"
 #include "view_log.hpp"
 #include "view_source.hpp"
 #include "view_video.hpp"
@@ -37,10 +36,7 @@ namespace {
 
 struct ViewArgs {
   std::string scene_path;
-  bool live = false;
-  std::string lcm_url;
-  std::string log_path;
-  double speed = 1;
+  ViewSourceArgs source;
   std::string png_path;
   std::string video_path;
   std::string background;
@@ -97,10 +93,8 @@ int run_view(const ViewArgs& args) {
     return code;
   };
   const bool window = args.png_path.empty() && args.video_path.empty();
-  std::optional<VideoFormat> video_format;
-  if (!args.video_path.empty() && !(video_format = video_format_for(args.video_path)))
-    return fail_with(fmt::format("--video {}: name it .mp4 (H.264) or .webm (VP9), formats browsers play",
-                                 args.video_path), program::kExitUsageError);
+  const auto video_format = args.video_path.empty() ? Result<VideoFormat>{} : video_format_for(args.video_path);
+  if (!video_format) return fail_with(video_format.error().message, program::kExitUsageError);
   if (window && !std::getenv("DISPLAY"))
     return fail_with("no display (DISPLAY is not set): use --png FILE or --video FILE", 2);
   const auto model = load_regions_model(args.scene_path, args.confidence);
@@ -108,10 +102,9 @@ int run_view(const ViewArgs& args) {
   auto widgets = ViewWidgets::create(model->scene);
   if (!widgets) return fail_with(fmt::format("{}: {}", args.scene_path, widgets.error().message), 2);
 
-  auto source = ViewSource::open(*model, {args.live, args.lcm_url, args.log_path, args.speed}, "covtrack view");
+  auto source = ViewSource::open(*model, args.source, "covtrack view");
   if (!source) return fail_with(source.error().message, source.error().exit_code);
   ViewSource& src = **source;
-  LogFollower* log = src.log();
 
   const cv::Size size(model->camera.width_px, model->camera.height_px);
   std::string warning;
@@ -128,19 +121,10 @@ int run_view(const ViewArgs& args) {
   install_stop_signals();
   src.announce();
   // A video of a log covers all of it; one of a scene or of live streams, 10 s.
-  const double duration_s = args.duration_s > 0 ? args.duration_s : (video && !log ? 10.0 : 0.0);
-  // Offline into a file (a scene or a log), nothing outside sets the pace: frames are
-  // rendered at their scene or log times as fast as they can be, and the same command
-  // gives the same pictures.
-  const bool virtual_clock = !src.live() && !window;
-  const auto start = std::chrono::steady_clock::now();
-  const auto period = std::chrono::duration<double>(1.0 / args.fps);
+  const double duration_s = args.duration_s > 0 ? args.duration_s : (video && !src.log() ? 10.0 : 0.0);
+  const ViewClock clock(args.fps, !src.live() && !window);
   for (long frame_index = 0;; ++frame_index) {
-    double elapsed_s = frame_index * period.count();
-    if (!virtual_clock) {
-      std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(frame_index * period));
-      elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    }
+    const double elapsed_s = clock.frame_time_s(frame_index);
     const auto now = src.advance(elapsed_s);
     if (!now) return fail_with(now.error().message, 2);
     const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s - 1e-9) || src.finished();
@@ -151,11 +135,7 @@ int run_view(const ViewArgs& args) {
     // --png takes its one frame at the end of --duration (live streams have arrived by then).
     if (!args.png_path.empty() && !last && duration_s > 0) continue;
 
-    // A log's own camera frames are the background unless --background names another.
-    cv::Mat image;
-    if (log && args.background.empty())
-      if (const cv::Mat& frame = log->image(warning); !frame.empty()) image = fit_to_view(frame, size);
-    if (image.empty()) image = background.next(warning);
+    cv::Mat image = src.picture(background, args.background.empty(), size, warning);
     if (!warning.empty()) {
       std::cerr << "covtrack view: " << warning << "\n";
       warning.clear();
@@ -188,10 +168,7 @@ void add_view_command(CLI::App& app) {
   auto args = std::make_shared<ViewArgs>();
   auto* cmd = app.add_subcommand("view", "Draw the objects' error regions over the camera view");
   cmd->add_option("SCENE", args->scene_path, "Scene file (config/scene_schema.md)")->required();
-  cmd->add_flag("--live", args->live, "Tracked transforms from the daemon's streams, not the scene's values");
-  cmd->add_option("--lcm-url,-u", args->lcm_url, "LCM URL for --live (default: $LCM_DEFAULT_URL or LCM's)");
-  cmd->add_option("--log", args->log_path, "Follow a recorded session (LCM log) at its own time");
-  cmd->add_option("--speed,-s", args->speed, "Speed factor of --log")->capture_default_str()->check(program::in_range(0.01, 1000.0));
+  add_view_source_options(*cmd, args->source);
   cmd->add_option("--png", args->png_path, "Write one frame (at the end of --duration, if given) and exit");
   cmd->add_option("--video", args->video_path,
                   "Write the frames to this video file: FILE.mp4 (H.264) or FILE.webm (VP9), which browsers play");

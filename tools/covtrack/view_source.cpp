@@ -12,6 +12,15 @@
 
 namespace covtrack::cli {
 
+void add_view_source_options(CLI::App& command, ViewSourceArgs& args) {
+  command.add_flag("--live", args.live, "Tracked transforms from the daemon's streams, not the scene's values");
+  command.add_option("--lcm-url,-u", args.lcm_url, "LCM URL for --live (default: $LCM_DEFAULT_URL or LCM's)");
+  command.add_option("--log", args.log_path, "Follow a recorded session (LCM log) at its own time");
+  command.add_option("--speed,-s", args.speed, "Speed factor of --log")
+      ->capture_default_str()
+      ->check(program::in_range(0.01, 1000.0));
+}
+
 std::expected<std::unique_ptr<ViewSource>, ViewSourceError> ViewSource::open(const RegionsModel& model,
                                                                              const ViewSourceArgs& args,
                                                                              std::string command) {
@@ -60,6 +69,12 @@ Result<std::int64_t> ViewSource::advance(double elapsed_s) {
   if (auto r = scene::report_keyframes(model_.scene, graph_, elapsed_s, *fixed_at_); !r)
     return fail(fmt::format("{}: {}", model_.scene_path, r.error().message));
   return *fixed_at_;
+}
+
+cv::Mat ViewSource::picture(ViewBackground& background, bool log_frames, cv::Size size, std::string& warning) {
+  if (log_ && log_frames)
+    if (const cv::Mat& frame = log_->image(warning); !frame.empty()) return fit_to_view(frame, size);
+  return background.next(warning);
 }
 
 void ViewSource::report_rejections() {

@@ -9,11 +9,14 @@
 #include <optional>
 #include <string>
 
+#include <CLI/CLI.hpp>
+
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/client/transform_graph.hpp"
 #include "covtrack/scene/scene_graph.hpp"
 #include "frame_mismatches.hpp"
 #include "regions_report.hpp"
+#include "view_background.hpp"
 #include "view_log.hpp"
 
 namespace covtrack::cli {
@@ -24,6 +27,9 @@ struct ViewSourceArgs {
   std::string log_path;
   double speed = 1;  // of the log's clock
 };
+
+// --live, --lcm-url, --log and --speed on a view's subcommand.
+void add_view_source_options(CLI::App& command, ViewSourceArgs& args);
 
 struct ViewSourceError {
   std::string message;
@@ -55,6 +61,10 @@ class ViewSource {
   const client::TransformGraph& graph() const { return graph_; }
   const LatestReport& latest_report() const { return latest_report_; }
   const FrameMismatches& mismatches() const { return mismatches_; }
+
+  // What this frame is drawn on: the log's latest camera frame when `log_frames` and it
+  // has one, else the background's next (both at `size`, a copy to draw on).
+  cv::Mat picture(ViewBackground& background, bool log_frames, cv::Size size, std::string& warning);
 
   // Stops the streams and tells on stderr what they brought and what was refused.
   void report_rejections();

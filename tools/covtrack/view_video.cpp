@@ -10,11 +10,11 @@
 
 namespace covtrack::cli {
 
-std::optional<VideoFormat> video_format_for(const std::string& path) {
+Result<VideoFormat> video_format_for(const std::string& path) {
   const std::string ending = std::filesystem::path(path).extension().string();
   if (ending == ".mp4") return VideoFormat{cv::VideoWriter::fourcc('a', 'v', 'c', '1'), "H.264", ".webm (VP9)"};
   if (ending == ".webm") return VideoFormat{cv::VideoWriter::fourcc('V', 'P', '9', '0'), "VP9", ".mp4 (H.264)"};
-  return std::nullopt;
+  return fail(fmt::format("--video {}: name it .mp4 (H.264) or .webm (VP9), formats browsers play", path));
 }
 
 Result<cv::VideoWriter> open_video(const std::string& path, const VideoFormat& format, double fps, cv::Size size) {

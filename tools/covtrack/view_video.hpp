@@ -17,8 +17,8 @@ struct VideoFormat {
   std::string alternative;  // the other ending, for when this encoder is missing
 };
 
-// By the file name's ending; nothing for an ending browsers have no format for here.
-std::optional<VideoFormat> video_format_for(const std::string& path);
+// By the file name's ending; an error saying which endings work for any other.
+Result<VideoFormat> video_format_for(const std::string& path);
 
 // The writer, or an error naming the file, the codec and the alternative.
 Result<cv::VideoWriter> open_video(const std::string& path, const VideoFormat& format, double fps, cv::Size size);

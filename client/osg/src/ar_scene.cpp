@@ -4,21 +4,24 @@
 #include <cmath>
 
 #include <opencv2/imgproc.hpp>
-#include <osg/Depth>
+#include <osg/BlendFunc>
 #include <osg/Geode>
 #include <osg/Image>
+#include <osg/Light>
+#include <osg/LightSource>
 #include <osg/LineWidth>
 
 #include "covtrack/osg/camera_matrices.hpp"
+#include "covtrack/osg/lens_warp.hpp"
 
 namespace covtrack::ar {
 namespace {
 
 // A camera drawing in the image's pixels, before or after the viewer's own.
-osg::ref_ptr<osg::Camera> pixel_camera(const client::Camera& c, osg::Camera::RenderOrder order) {
+osg::ref_ptr<osg::Camera> pixel_camera(const client::Camera& c, osg::Camera::RenderOrder order, int order_num = 0) {
   osg::ref_ptr<osg::Camera> cam = new osg::Camera;
   cam->setReferenceFrame(osg::Transform::ABSOLUTE_RF);
-  cam->setRenderOrder(order);
+  cam->setRenderOrder(order, order_num);
   cam->setViewport(0, 0, c.width_px, c.height_px);
   cam->setProjectionMatrix(pixel_projection(c));
   cam->setViewMatrix(osg::Matrixd::identity());
@@ -63,9 +66,61 @@ void finish_lines(osg::Geometry& g) {
 }  // namespace
 
 ArScene::ArScene(client::Camera camera, ArSceneOptions options)
-    : camera_(std::move(camera)), options_(options), root_(new osg::Group) {
+    : camera_(std::move(camera)), options_(options), root_(new osg::Group), objects_(new osg::Group) {
   build_background();
+  if (has_distortion(camera_))
+    build_lens();
+  else
+    root_->addChild(objects_);  // drawn by the viewer's camera
   build_overlay();
+}
+
+void ArScene::build_lens() {
+  const LensCanvas canvas = lens_canvas(camera_);
+  osg::ref_ptr<osg::Texture2D> texture = new osg::Texture2D;
+  texture->setTextureSize(canvas.pinhole.width_px, canvas.pinhole.height_px);
+  texture->setInternalFormat(GL_RGBA);
+  texture->setFilter(osg::Texture::MIN_FILTER, osg::Texture::LINEAR);
+  texture->setFilter(osg::Texture::MAG_FILTER, osg::Texture::LINEAR);
+  texture->setResizeNonPowerOfTwoHint(false);
+  // The objects through the canvas's pinhole, into the texture, on a clear background.
+  lens_ = new osg::Camera;
+  lens_->setReferenceFrame(osg::Transform::ABSOLUTE_RF);
+  lens_->setRenderOrder(osg::Camera::PRE_RENDER, 1);
+  lens_->setRenderTargetImplementation(osg::Camera::FRAME_BUFFER_OBJECT);
+  lens_->attach(osg::Camera::COLOR_BUFFER, texture.get());
+  lens_->setViewport(0, 0, canvas.pinhole.width_px, canvas.pinhole.height_px);
+  lens_->setClearColor(osg::Vec4(0, 0, 0, 0));
+  lens_->setClearMask(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  lens_->setProjectionMatrix(projection_of(canvas.pinhole, options_.near_m, options_.far_m));
+  lens_->setViewMatrix(opencv_to_eye());
+  lens_->setComputeNearFarMode(osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
+  // A camera drawing into a texture has no share of the viewer's headlight: its own, a
+  // light from the eye as the viewer's is.
+  osg::ref_ptr<osg::Light> light = new osg::Light(0);
+  light->setPosition(osg::Vec4(0, 0, 1, 0));
+  light->setAmbient(osg::Vec4(0.05f, 0.05f, 0.05f, 1));
+  light->setDiffuse(osg::Vec4(0.8f, 0.8f, 0.8f, 1));
+  light->setSpecular(osg::Vec4(1, 1, 1, 1));
+  osg::ref_ptr<osg::LightSource> headlight = new osg::LightSource;
+  headlight->setLight(light);
+  headlight->setReferenceFrame(osg::LightSource::ABSOLUTE_RF);
+  headlight->setLocalStateSetModes(osg::StateAttribute::ON);
+  headlight->addChild(objects_);
+  lens_->getOrCreateStateSet()->setMode(GL_LIGHTING, osg::StateAttribute::ON);
+  lens_->addChild(headlight);
+  root_->addChild(lens_);
+  // Then laid over the video, bent as the lens bends it.
+  osg::ref_ptr<osg::Camera> warp = pixel_camera(camera_, osg::Camera::POST_RENDER, 0);
+  warp->setClearMask(0);
+  osg::ref_ptr<osg::Geometry> mesh = lens_warp_mesh(camera_, canvas);
+  osg::StateSet* state = mesh->getOrCreateStateSet();
+  state->setTextureAttributeAndModes(0, texture, osg::StateAttribute::ON);
+  state->setAttributeAndModes(new osg::BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA));
+  osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+  geode->addDrawable(mesh);
+  warp->addChild(geode);
+  root_->addChild(warp);
 }
 
 void ArScene::build_background() {
@@ -101,7 +156,7 @@ void ArScene::build_background() {
 }
 
 void ArScene::build_overlay() {
-  overlay_ = pixel_camera(camera_, osg::Camera::POST_RENDER);
+  overlay_ = pixel_camera(camera_, osg::Camera::POST_RENDER, 1);
   overlay_->setClearMask(0);
   overlay_->getOrCreateStateSet()->setAttributeAndModes(new osg::LineWidth(options_.line_width_px));
   outer_lines_ = line_geometry(options_.outer_colour);
@@ -122,7 +177,7 @@ void ArScene::add_object(std::vector<osg::ref_ptr<osg::Node>> per_level) {
   for (const auto& node : per_level) levels->addChild(node, false);
   if (levels->getNumChildren() > 0) levels->setSingleChildOn(0);
   transform->addChild(levels);
-  root_->addChild(transform);
+  objects_->addChild(transform);
   transforms_.push_back(transform);
   switches_.push_back(levels);
   osg::ref_ptr<osgText::Text> text = new osgText::Text;
@@ -139,6 +194,10 @@ void ArScene::add_object(std::vector<osg::ref_ptr<osg::Node>> per_level) {
 
 void ArScene::configure(osg::Camera& viewer_camera) const {
   viewer_camera.setViewport(0, 0, camera_.width_px, camera_.height_px);
+  if (lens_) {  // the objects are drawn through the lens; this camera draws nothing itself
+    viewer_camera.setClearMask(0);
+    return;
+  }
   viewer_camera.setProjectionMatrix(projection_of(camera_, options_.near_m, options_.far_m));
   viewer_camera.setViewMatrix(opencv_to_eye());
   // OSG would otherwise move the near and far planes to the scene's bounds each frame.

@@ -4,12 +4,14 @@
 //
 //   root
 //    |- background: a pre-render camera drawing the video frame (set_video) in pixels
-//    |- one TrackedTransform per object: T_camera_object, over a Level-of-Error switch
-//    |  whose children (any subgraphs, one per level) the application gives
+//    |- objects: per object a transform (T_camera_object) over a Level-of-Error switch
+//    |  whose children (any subgraphs, one per level) the application gives; through a
+//    |  camera with lens distortion drawn into a texture and bent as the lens bends
+//    |  (lens_warp.hpp)
 //    '- overlay: a post-render camera drawing outer and inner regions, leader lines and
 //       labels in pixels
 //
-// The viewer's own camera draws the tracked objects: configure() sets it to the
+// Without distortion the viewer's own camera draws the objects: configure() sets it to the
 // calibration's projection and the OpenCV camera frame (camera_matrices.hpp), and leaves
 // the colour buffer to the background.
 #include <span>
@@ -65,12 +67,13 @@ class ArScene {
 
  private:
   void build_background();
+  void build_lens();
   void build_overlay();
 
   client::Camera camera_;
   ArSceneOptions options_;
-  osg::ref_ptr<osg::Group> root_;
-  osg::ref_ptr<osg::Camera> background_, overlay_;
+  osg::ref_ptr<osg::Group> root_, objects_;
+  osg::ref_ptr<osg::Camera> background_, lens_, overlay_;
   osg::ref_ptr<osg::Texture2D> video_;
   osg::ref_ptr<osg::Geometry> video_quad_;
   osg::ref_ptr<osg::Geometry> outer_lines_, inner_lines_;

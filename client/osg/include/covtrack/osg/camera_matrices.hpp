@@ -2,9 +2,7 @@
 // The matrices that make OpenSceneGraph draw what a calibrated camera sees: covtrack's
 // poses and cameras use OpenCV's camera frame (x right, y down, z forward; pixel centres
 // at integer coordinates), OpenGL's eye frame looks down -z with y up and puts pixel
-// centres at half-integers. Lens distortion is not drawn: OpenGL projects through the
-// pinhole part only, so a renderer over video should undistort the video (or use a camera
-// calibrated without distortion) for the drawing to line up with the regions.
+// centres at half-integers. These are the pinhole part; lens_warp.hpp adds the lens.
 #include <osg/Matrixd>
 
 #include "covtrack/client/camera.hpp"
