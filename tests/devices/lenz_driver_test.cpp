@@ -2,6 +2,10 @@
 // honesty of the reported uncertainty against the emulator's true train position, the
 // LI-USB framing, a port that disappears mid-run and comes back, and a line of pure
 // noise, which must end the run as a failure (the daemon then resets the device).
+// Driver and emulator run on one simulated clock (manual_clock.hpp) that the test moves
+// in steps, waiting after each step until both have caught up: the bytes go over the
+// real terminal, but no test waits for time to pass, and a loaded machine only makes
+// the run slower, never different.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -21,7 +25,7 @@
 #include "covtrack/devices/lenz/lenz_driver.hpp"
 #include "covtrack/devices/serial/pseudo_terminal.hpp"
 #include "covtrack/emulators/lenz/lenz_emulator.hpp"
-#include "covtrack/protocol/clock.hpp"
+#include "manual_clock.hpp"
 
 using namespace covtrack;
 using namespace covtrack::lenz;
@@ -38,6 +42,11 @@ std::shared_ptr<const TrackLayout> short_layout() {
 // Accelerate, cruise, slow down, cruise, stop, wait, restart (one cycle is about 9 s).
 const std::vector<SpeedStep> kProfile{{0.5, 1.5}, {0.15, 1}, {0, 1}, {0.4, 1.5}};
 
+// The simulated clock moves in steps this long. A crossing then reaches the driver at
+// most two steps after it happened (the emulator sees it at the step's end, the driver
+// reads it in that step or the next), well within the 50 ms the dead reckoning allows.
+constexpr auto kStep = 5ms;
+
 struct Rig {
   explicit Rig(Interface interface, const std::string& name) {
     LenzEmulatorOptions options;
@@ -46,9 +55,10 @@ struct Rig {
     options.profile = kProfile;
     options.start_s = 0.1;
     options.link_path = ::testing::TempDir() + "/covtrack_lenz_" + name + "_" + std::to_string(::getpid());
-    auto created = LenzEmulator::create(options);
+    auto created = LenzEmulator::create(options, clock);
     EXPECT_TRUE(created) << created.error().message;
     emulator = std::move(*created);
+    clock.join();
     emulator_thread = std::jthread([this](std::stop_token stop) { emulator->run(stop, nullptr); });
 
     config.device = "train";
@@ -61,11 +71,14 @@ struct Rig {
     config.link_timeout_s = 1.0;
     config.no_valid_frames_s = 1.0;
     config.reconnect_s = 0.1;
-    driver = make_lenz_driver(config);
+    driver = make_lenz_driver(config, clock);
+    clock.join();
     driver_thread = std::jthread([this](std::stop_token stop) {
       result = driver->run(sink, stop);
       returned = true;
+      clock.leave();
     });
+    EXPECT_TRUE(clock.settle()) << "driver or emulator did not start";
   }
   ~Rig() {
     driver_thread.request_stop();
@@ -81,6 +94,7 @@ struct Rig {
     return sink.raw_bytes;
   }
 
+  test::ManualClock clock{kStep};  // first: outlives the threads that wait on it
   std::unique_ptr<LenzEmulator> emulator;
   LenzConfig config;
   std::unique_ptr<Driver> driver;
@@ -143,7 +157,7 @@ Honesty honesty_of(const std::vector<PoseSample>& poses, const LenzEmulator& emu
 
 TEST(LenzDriver, UncertaintyContainsTheTruthOverSpeedChangesAndAStop) {
   Rig rig(Interface::Li101f, "honesty");
-  std::this_thread::sleep_for(9s);
+  ASSERT_TRUE(rig.clock.run_for(9s));
   const auto poses = rig.poses();
   const TrackLayout& layout = rig.emulator->layout();
   std::set<std::string> sensors;
@@ -175,10 +189,9 @@ TEST(LenzDriver, ForgedFeedbackNamingAFarSectionIsAskedAgainAndDropped) {
   const auto n = layout.sections().size();
   int forged = 0;
   std::mt19937 rng(7);
-  const auto end = std::chrono::steady_clock::now() + 9s;
-  while (std::chrono::steady_clock::now() < end) {
-    std::this_thread::sleep_for(150ms);  // paces the noise; nothing waits on a result here
-    const std::size_t here = layout.section_at(rig.emulator->true_s_at(now_us()));
+  while (rig.clock.elapsed_s() < 9.0) {
+    ASSERT_TRUE(rig.clock.run_for(150ms));  // paces the noise
+    const std::size_t here = layout.section_at(rig.emulator->true_s_at(rig.clock.now_us()));
     const std::size_t far = (here + 3 + rng() % (n - 5)) % n;  // neither neighbour, nor here
     const auto& in = layout.sections()[far].input;
     const bool upper = in.input > 4;
@@ -187,6 +200,7 @@ TEST(LenzDriver, ForgedFeedbackNamingAFarSectionIsAskedAgainAndDropped) {
                                   static_cast<std::uint8_t>(0x40 | (upper ? 0x10 : 0) | bit)});
     ++forged;
   }
+  ASSERT_TRUE(rig.clock.run_for(150ms));  // the last forged change is asked for again too
   const Honesty h = honesty_of(rig.poses(), *rig.emulator);
   ASSERT_GT(h.degraded, 300);
   EXPECT_GE(h.inside_share(), 0.99);
@@ -201,7 +215,7 @@ TEST(LenzDriver, ForgedFeedbackNamingAFarSectionIsAskedAgainAndDropped) {
 
 TEST(LenzDriver, LiUsbPrefixesBothWays) {
   Rig rig(Interface::LiUsb, "liusb");
-  std::this_thread::sleep_for(2s);
+  ASSERT_TRUE(rig.clock.run_for(2s));
   const auto poses = rig.poses();
   const auto degraded = std::count_if(poses.begin(), poses.end(),
                                       [](const PoseSample& p) { return p.status == TrackingStatus::Degraded; });
@@ -216,14 +230,17 @@ TEST(LenzDriver, LiUsbPrefixesBothWays) {
 
 TEST(LenzDriver, PortClosedMidRunGoesLostAndResumesOnReopen) {
   Rig rig(Interface::Li101f, "unplug");
-  std::this_thread::sleep_for(1500ms);
-  const std::int64_t unplugged_us = now_us();
+  ASSERT_TRUE(rig.clock.run_for(1500ms));
+  const std::int64_t unplugged_us = rig.clock.now_us();
   rig.emulator->unplug();
-  std::this_thread::sleep_for(2500ms);
-  const std::int64_t replugged_us = now_us();
+  ASSERT_TRUE(rig.clock.run_for(2500ms));
+  const std::int64_t replugged_us = rig.clock.now_us();
   rig.emulator->replug();
-  std::this_thread::sleep_for(2000ms);
+  ASSERT_TRUE(rig.clock.run_for(2000ms));
   const auto poses = rig.poses();
+  const std::int64_t step_us = std::chrono::microseconds(kStep).count();
+  const auto period_us = std::llround(1e6 / rig.config.rate_hz);
+  const auto reconnect_us = std::llround(1e6 * rig.config.reconnect_s);
 
   for (const std::string vehicle : {"loco", "car1", "car2"}) {
     std::int64_t first_lost_us = -1, first_back_us = -1;
@@ -242,8 +259,14 @@ TEST(LenzDriver, PortClosedMidRunGoesLostAndResumesOnReopen) {
     }
     EXPECT_TRUE(degraded_before) << vehicle;
     ASSERT_GE(first_lost_us, 0) << vehicle << " never went LOST";
-    EXPECT_LT(first_lost_us - unplugged_us, 2'000'000) << vehicle;
+    // The emulator closes the terminal in the first step after unplug(), the driver sees
+    // the hang-up in that step or the next, and the next sample due reports LOST.
+    EXPECT_LE(first_lost_us - unplugged_us, 2 * step_us + period_us) << vehicle;
     ASSERT_GE(first_back_us, 0) << vehicle << " did not resume";
+    // The driver tries the port every reconnect_s; the new terminal is there one step
+    // after replug(), the startup requests and their answers take a step each way (two
+    // if they cross a step), and the next sample due is tracking again.
+    EXPECT_LE(first_back_us - replugged_us, reconnect_us + 4 * step_us + period_us) << vehicle;
     std::printf("%s: LOST %.3f s after the unplug, tracking again %.3f s after the replug\n", vehicle.c_str(),
                 (first_lost_us - unplugged_us) * 1e-6, (first_back_us - replugged_us) * 1e-6);
   }
@@ -277,25 +300,31 @@ TEST(LenzDriver, LineOfPureNoiseFailsWithNoValidFrames) {
   config.keepalive_s = 0.2;
   config.link_timeout_s = 1.0;
   config.no_valid_frames_s = 1.0;
-  auto driver = make_lenz_driver(config);
+  test::ManualClock clock{kStep};
+  auto driver = make_lenz_driver(config, clock);
   test::CaptureSink sink;
   std::promise<Result<void>> ended;
   auto result = ended.get_future();
-  const auto started = std::chrono::steady_clock::now();
-  std::jthread driver_thread([&](std::stop_token stop) { ended.set_value(driver->run(sink, stop)); });
+  clock.join();
+  std::jthread driver_thread([&](std::stop_token stop) {
+    ended.set_value(driver->run(sink, stop));
+    clock.leave();
+  });
+  ASSERT_TRUE(clock.settle()) << "the driver did not start";
 
-  // About 20 kB/s, ten times what an LI101F at 19200 baud can send; the driver's requests
-  // are drained so that its writes never block.
+  // 100 bytes a 5 ms step, about 20 kB/s: ten times what an LI101F at 19200 baud can
+  // send; the driver's requests are drained so that its writes never block.
   std::mt19937 rng(22);
-  std::uint8_t noise[200], drained[256];
+  std::uint8_t noise[100], drained[256];
   std::uint64_t noise_bytes = 0;
-  while (result.wait_for(10ms) != std::future_status::ready && std::chrono::steady_clock::now() - started < 20s) {
+  while (result.wait_for(0s) != std::future_status::ready && clock.elapsed_s() < 20) {
     while (pty->read_some(drained, 0ms).value_or(0) > 0) {}
     for (auto& b : noise) b = static_cast<std::uint8_t>(rng());
     noise_bytes += pty->write(noise).value_or(0);
+    ASSERT_TRUE(clock.run_for(kStep));
   }
   ASSERT_EQ(result.wait_for(0s), std::future_status::ready) << "the driver never failed on 20 s of noise";
-  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const double took_s = clock.elapsed_s();
   const auto outcome = result.get();
   ASSERT_FALSE(outcome) << "the driver stopped on its own without an error";
   const std::string& message = outcome.error().message;
@@ -303,9 +332,9 @@ TEST(LenzDriver, LineOfPureNoiseFailsWithNoValidFrames) {
               static_cast<unsigned long long>(noise_bytes), sink.errors, took_s, message.c_str());
   EXPECT_NE(message.find("no valid frames for 1.0 s"), std::string::npos) << message;
   EXPECT_NE(message.find(config.port), std::string::npos) << message;
+  // In the step that reaches the limit (the driver looks at the clock in every step).
   EXPECT_GE(took_s, config.no_valid_frames_s);
-  // Within the limit plus the driver's 20 ms polling, with room for a loaded machine.
-  EXPECT_LT(took_s, config.no_valid_frames_s + 3.0);
+  EXPECT_LE(took_s, config.no_valid_frames_s + std::chrono::duration<double>(kStep).count());
   EXPECT_GT(sink.errors, 10);  // the noise's bad frames were counted on the way
   std::lock_guard lock(sink.m);
   ASSERT_FALSE(sink.poses.empty());

@@ -1,6 +1,8 @@
 // The serial 6-DOF driver against its emulators over real pseudo-terminals: the
 // configuration sequence per protocol, NEES of the reported covariance against the
 // emulator's truth, trouble flags, units, and the port going away and coming back.
+// The tests that time how soon a silent unit is reported LOST run driver and emulator on
+// a simulated clock (manual_clock.hpp), so that a loaded machine cannot make them late.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -14,7 +16,7 @@
 #include "capture_sink.hpp"
 #include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 #include "covtrack/emulate6dof/emulator.hpp"
-#include "covtrack/protocol/clock.hpp"
+#include "manual_clock.hpp"
 
 using namespace covtrack;
 using namespace covtrack::serial6dof;
@@ -31,9 +33,11 @@ struct Rig {
   std::map<std::string, Pose> truth;  // the emulated receivers do not move
 };
 
+// `clock`: the emulator runs on it (and joins it), else on the real clock.
 Rig make_rig(Model model, const std::vector<int>& stations, const std::string& name,
              double trouble_every_s = 0, double rate_hz = 0,
-             const std::function<void(emulate6dof::EmulatorConfig&)>& tweak = {}) {
+             const std::function<void(emulate6dof::EmulatorConfig&)>& tweak = {},
+             test::ManualClock* clock = nullptr) {
   emulate6dof::EmulatorConfig ec;
   ec.model = model;
   ec.link_path = link_path(name);
@@ -43,10 +47,11 @@ Rig make_rig(Model model, const std::vector<int>& stations, const std::string& n
   ec.trouble_every_s = trouble_every_s;
   ec.seed = 7 + static_cast<std::uint64_t>(model);  // each model its own noise
   if (tweak) tweak(ec);
-  auto e = emulate6dof::Emulator::create(ec);
+  auto e = clock ? emulate6dof::Emulator::create(ec, *clock) : emulate6dof::Emulator::create(ec);
   EXPECT_TRUE(e) << e.error().message;
   Rig rig{std::move(*e), {}};
   for (const auto& s : ec.stations) rig.truth[s.name] = s.T_source_receiver;
+  if (clock) clock->join();
   rig.emulator->start(nullptr);
   return rig;
 }
@@ -64,30 +69,56 @@ Serial6dofConfig driver_config(Model model, const std::vector<int>& stations, co
   return c;
 }
 
-// Runs the driver until `wanted` non-LOST poses arrived (or 30 s passed).
+// Runs the driver until `wanted` non-LOST poses arrived (or 30 s passed), on `clock`
+// (which the driver joins) if given, else on the real clock.
 Result<void> run_for_samples(test::CaptureSink& sink, const Serial6dofConfig& c, std::size_t wanted,
-                             std::uint64_t run_index = 0) {
-  auto driver = make_serial6dof_driver(c, run_index);
+                             std::uint64_t run_index = 0, test::ManualClock* clock = nullptr) {
+  auto driver = clock ? make_serial6dof_driver(c, run_index, *clock) : make_serial6dof_driver(c, run_index);
   std::stop_source stop;
   Result<void> result;
   std::atomic<bool> done = false;
+  if (clock) clock->join();
   std::thread t([&] {
     result = driver->run(sink, stop.get_token());
     done = true;
+    if (clock) clock->leave();
   });
-  for (int i = 0; i < 3000 && !done; ++i) {
-    {
-      std::lock_guard l(sink.m);
-      std::size_t good = 0;
-      for (const auto& p : sink.poses) good += p.status != TrackingStatus::Lost;
-      if (good >= wanted) break;
-    }
-    std::this_thread::sleep_for(10ms);
+  const auto enough = [&] {
+    std::lock_guard l(sink.m);
+    std::size_t good = 0;
+    for (const auto& p : sink.poses) good += p.status != TrackingStatus::Lost;
+    return done || good >= wanted;
+  };
+  if (clock) {
+    clock->run_until(enough, 30s);
+  } else {
+    for (int i = 0; i < 3000 && !enough(); ++i) std::this_thread::sleep_for(10ms);
   }
   stop.request_stop();
   t.join();
   return result;
 }
+
+// A first run of the driver on `clock`, in its own thread, until it returns or the test
+// ends; the constructor returns once the emulator has streamed 50 records to it.
+struct ClockedRun {
+  ClockedRun(const Serial6dofConfig& c, test::ManualClock& clock, const emulate6dof::Emulator& emulator)
+      : driver(make_serial6dof_driver(c, 0, clock)) {
+    clock.join();
+    thread = std::jthread([this, &clock](std::stop_token stop) {
+      result = driver->run(sink, stop);
+      returned = true;
+      clock.leave();
+    });
+    EXPECT_TRUE(clock.run_until([&] { return emulator.records_sent() >= 50; }, 30s));
+  }
+
+  std::unique_ptr<Driver> driver;
+  test::CaptureSink sink;
+  Result<void> result;
+  std::atomic<bool> returned = false;
+  std::jthread thread;
+};
 
 struct NeesSummary {
   double mean = 0;
@@ -250,17 +281,16 @@ TEST(Serial6dofDriver, SilentPortIsAClearError) {
 
 TEST(Serial6dofDriver, UnpluggedPortGivesLostWithinTwoPeriodsThenRecovers) {
   const double rate_hz = 50;
-  Rig rig = make_rig(Model::Liberty, {1}, "unplug", 0, rate_hz);
+  test::ManualClock clock;
+  Rig rig = make_rig(Model::Liberty, {1}, "unplug", 0, rate_hz, {}, &clock);
   const auto c = driver_config(Model::Liberty, {1}, rig.emulator->device_path(), rate_hz);
-  test::CaptureSink sink;
-  auto driver = make_serial6dof_driver(c, 0);
-  std::stop_source stop;
-  Result<void> result;
-  std::thread t([&] { result = driver->run(sink, stop.get_token()); });
-  while (rig.emulator->records_sent() < 50) std::this_thread::sleep_for(5ms);
-  const std::int64_t unplugged_us = now_us();
+  ClockedRun run(c, clock, *rig.emulator);
+  const std::int64_t unplugged_us = clock.now_us();
   rig.emulator->unplug();
-  t.join();  // the driver fails on its own: the port is gone
+  ASSERT_TRUE(clock.run_until([&] { return run.returned.load(); }, 30s));  // the port is gone: it fails
+  run.thread.join();
+  const auto& result = run.result;
+  const auto& sink = run.sink;
   ASSERT_FALSE(result);
   EXPECT_NE(result.error().message.find("LOST"), std::string::npos) << result.error().message;
   std::int64_t lost_us = 0;
@@ -272,9 +302,9 @@ TEST(Serial6dofDriver, UnpluggedPortGivesLostWithinTwoPeriodsThenRecovers) {
 
   // Back again: the restarted driver (run 1, which resets the unit) streams again.
   rig.emulator->replug();
-  while (!rig.emulator->plugged()) std::this_thread::sleep_for(5ms);
+  ASSERT_TRUE(clock.run_until([&] { return rig.emulator->plugged(); }, 30s));
   test::CaptureSink after;
-  const Result<void> back = run_for_samples(after, c, 100, 1);
+  const Result<void> back = run_for_samples(after, c, 100, 1, &clock);
   EXPECT_TRUE(back) << back.error().message;
   EXPECT_GE(nees(after, rig).n, 100) << "errors: " << after.errors;
   EXPECT_GE(rig.emulator->resets(), 1u);
@@ -312,16 +342,17 @@ TEST(Serial6dofConfig, DefaultsComeFromTheModel) {
 
 TEST(Serial6dofDriver, HungUnitGivesLostThenTheRestartResetsIt) {
   const double rate_hz = 50;
-  Rig rig = make_rig(Model::Fastrak, {1, 2}, "hung", 0, rate_hz);
+  test::ManualClock clock;
+  Rig rig = make_rig(Model::Fastrak, {1, 2}, "hung", 0, rate_hz, {}, &clock);
   const auto c = driver_config(Model::Fastrak, {1, 2}, rig.emulator->device_path(), rate_hz);
-  test::CaptureSink sink;
-  auto driver = make_serial6dof_driver(c, 0);
-  Result<void> result;
-  std::thread t([&] { result = driver->run(sink, std::stop_source().get_token()); });
-  while (rig.emulator->records_sent() < 50) std::this_thread::sleep_for(5ms);
-  const std::int64_t hung_us = now_us();
+  ClockedRun run(c, clock, *rig.emulator);
+  const std::int64_t hung_us = clock.now_us();
   rig.emulator->hang();
-  t.join();  // the driver gives up on a silent unit by itself (after ~1 s)
+  // The driver gives up on a silent unit by itself (after 1 s).
+  ASSERT_TRUE(clock.run_until([&] { return run.returned.load(); }, 30s));
+  run.thread.join();
+  const auto& result = run.result;
+  const auto& sink = run.sink;
   ASSERT_FALSE(result);
   EXPECT_NE(result.error().message.find("no records"), std::string::npos) << result.error().message;
   std::map<std::string, std::int64_t> first_lost_us;
@@ -334,7 +365,7 @@ TEST(Serial6dofDriver, HungUnitGivesLostThenTheRestartResetsIt) {
   // The restart (run 1) resets the unit, which cures it.
   const auto resets_before = rig.emulator->resets();
   test::CaptureSink after;
-  EXPECT_TRUE(run_for_samples(after, c, 100, 1));
+  EXPECT_TRUE(run_for_samples(after, c, 100, 1, &clock));
   EXPECT_GT(rig.emulator->resets(), resets_before);
   EXPECT_FALSE(rig.emulator->hung());
   EXPECT_GE(nees(after, rig).n, 100);

@@ -69,7 +69,12 @@ sigma_rad = [0.001, 0.001, 0.001]
 )" + GetParam().config;
   Collector collector(url);
   test::DaemonProcess daemon(config, url);
+  // 3 s at least, and until the bad device has been restarted and the sim device has
+  // published 50 poses (1 s at its rate): a loaded machine only makes the wait longer.
   collector.run_for(3.0);
+  const auto restarted = [&] { return collector.status.count("bad") && collector.status["bad"].restarts >= 1; };
+  for (int waited = 0; waited < 60 && !(restarted() && collector.poses["covtrack/pose/steady/s0"] > 50); ++waited)
+    collector.run_for(0.5);
   EXPECT_GT(collector.poses["covtrack/pose/steady/s0"], 50) << "the sim device must keep publishing";
   ASSERT_TRUE(collector.status.count("bad"));
   const device_status_t& bad = collector.status["bad"];

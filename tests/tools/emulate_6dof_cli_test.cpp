@@ -10,6 +10,7 @@
 
 #include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 #include "../devices/capture_sink.hpp"
+#include "test_support.hpp"
 
 using namespace covtrack;
 using namespace std::chrono_literals;
@@ -37,14 +38,23 @@ TEST(Emulate6dofCli, DriverTalksToTheCommandAndItExitsZero) {
   auto driver = serial6dof::make_serial6dof_driver(c, 0);
   std::stop_source stop;
   std::thread t([&] { EXPECT_TRUE(driver->run(sink, stop.get_token())); });
-  std::this_thread::sleep_for(1500ms);
+  int ok = 0;
+  bool both = false;
+  // Until enough records came, or the emulator's 4 s are nearly over.
+  covtrack::testing::eventually(
+      [&] {
+        std::lock_guard lock(sink.m);
+        ok = 0;
+        for (const auto& p : sink.poses) {
+          ok += p.status != TrackingStatus::Lost;
+          both |= p.sensor == "st3";
+        }
+        return ok > 100 && both;
+      },
+      3500ms);
   stop.request_stop();
   t.join();
-  int ok = 0;
-  for (const auto& p : sink.poses) ok += p.status != TrackingStatus::Lost;
   EXPECT_GT(ok, 100) << "records from the emulator process";
-  bool both = false;
-  for (const auto& p : sink.poses) both |= p.sensor == "st3";
   EXPECT_TRUE(both) << "station 3 was configured on both sides";
 
   int status = 0;

@@ -16,8 +16,6 @@
 #include "covtrack/devices/fiducial/frame_source.hpp"
 #include "covtrack/devices/fiducial/raw_detection.hpp"
 #include "covtrack/devices/fiducial/tag_pose.hpp"
-#include "covtrack/devices/interruptible_sleep.hpp"
-#include "covtrack/protocol/clock.hpp"
 
 namespace covtrack::fiducial {
 namespace {
@@ -33,7 +31,7 @@ std::string view_detail(bool mapped_in_view, const std::set<int>& unmapped) {
 
 class FiducialDriver final : public Driver {
  public:
-  explicit FiducialDriver(const FiducialConfig& config) : config_(config) {
+  FiducialDriver(const FiducialConfig& config, DriverClock& clock) : config_(config), clock_(clock) {
     for (const auto& [id, size] : config_.tag_size_m) tags_[id] = {{id, size, Pose::Identity()}, std::nullopt};
     for (std::size_t b = 0; b < config_.bundles.size(); ++b)
       for (const BundleTag& t : config_.bundles[b].tags) tags_[t.id] = {t, b};
@@ -60,19 +58,19 @@ class FiducialDriver final : public Driver {
 
     using namespace std::chrono;
     const bool paced = !(*source)->is_camera() && config_.rate_hz > 0;
-    const auto period = paced ? duration_cast<steady_clock::duration>(duration<double>(1.0 / config_.rate_hz))
-                              : steady_clock::duration::zero();
-    auto next = steady_clock::now();
+    const auto period = paced ? duration_cast<DriverClock::duration>(duration<double>(1.0 / config_.rate_hz))
+                              : DriverClock::duration::zero();
+    auto next = clock_.now();
     cv::Mat gray;
     for (std::uint32_t index = 0; !stop.stop_requested(); ++index) {
       if (paced) {
         next += period;
-        if (!sleep_until(stop, next)) return {};
+        if (!clock_.sleep_until(stop, next)) return {};
       }
       auto read = (*source)->next();
       if (!read) return std::unexpected(read.error());
       if (read->kind == FrameRead::Kind::End) {  // a file source played once: idle until stopped
-        while (sleep_for(stop, milliseconds(50))) {}
+        while (clock_.sleep_until(stop, clock_.now() + milliseconds(50))) {}
         return {};
       }
       if (read->kind == FrameRead::Kind::Damaged) {
@@ -81,7 +79,7 @@ class FiducialDriver final : public Driver {
         continue;
       }
       const cv::Mat& frame = read->image;
-      const std::int64_t time_us = now_us();
+      const std::int64_t time_us = clock_.now_us();
       to_gray8(frame, gray);
       if (gray.cols != camera_.width_px || gray.rows != camera_.height_px)
         return fail(fmt::format("'{}': frame is {}x{} but the calibration '{}' is for {}x{}",
@@ -186,6 +184,7 @@ class FiducialDriver final : public Driver {
   }
 
   FiducialConfig config_;
+  DriverClock& clock_;
   CameraModel camera_;
   std::unique_ptr<TagDetector> detector_;
   std::uint64_t frames_published_ = 0;  // frames considered for publish_images (every n-th goes)
@@ -200,8 +199,8 @@ class FiducialDriver final : public Driver {
 
 }  // namespace
 
-std::unique_ptr<Driver> make_fiducial_driver(const FiducialConfig& config, std::uint64_t) {
-  return std::make_unique<FiducialDriver>(config);
+std::unique_ptr<Driver> make_fiducial_driver(const FiducialConfig& config, std::uint64_t, DriverClock& clock) {
+  return std::make_unique<FiducialDriver>(config, clock);
 }
 
 }  // namespace covtrack::fiducial

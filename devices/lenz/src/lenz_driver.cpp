@@ -7,18 +7,16 @@
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/interruptible_sleep.hpp"
 #include "covtrack/devices/lenz/feedback_confirmation.hpp"
 #include "covtrack/devices/lenz/xpressnet_framing.hpp"
 #include "covtrack/devices/lenz/xpressnet_messages.hpp"
 #include "covtrack/devices/serial/serial_port.hpp"
 #include "covtrack/devices/valid_frame_watchdog.hpp"
-#include "covtrack/protocol/clock.hpp"
 
 namespace covtrack::lenz {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using Clock = DriverClock;
 using std::chrono::duration;
 using std::chrono::duration_cast;
 using std::chrono::milliseconds;
@@ -27,8 +25,6 @@ template <class... F>
 struct overloaded : F... {
   using F::operator()...;
 };
-
-double now_s() { return static_cast<double>(now_us()) * 1e-6; }
 
 // A held feedback change (feedback_confirmation.hpp) is asked for again at once; an
 // interface answers within tens of milliseconds, so one not confirmed in this long is
@@ -39,15 +35,16 @@ Clock::duration seconds(double s) { return duration_cast<Clock::duration>(durati
 
 class LenzDriver final : public Driver {
  public:
-  explicit LenzDriver(const LenzConfig& config)
+  LenzDriver(const LenzConfig& config, DriverClock& clock)
       : config_(config),
+        clock_(clock),
         reckoner_(*config.layout, config.reckoning),
         feedback_(*config.layout, kConfirmTimeout_s),
         period_(seconds(1.0 / config.rate_hz)) {}
 
   Result<void> run(SampleSink& sink, std::stop_token stop) override {
     bool connected_before = false;
-    next_sample_ = Clock::now();
+    next_sample_ = clock_.now();
     while (!stop.stop_requested()) {
       auto port = serial::SerialPort::open({config_.port, config_.baud, config_.rts_cts});
       if (!port) {
@@ -79,21 +76,19 @@ class LenzDriver final : public Driver {
   // run (the device has FAILED, the daemon resets it); a silent one is reopened here.
   Result<void> session(serial::SerialPort& port, SampleSink& sink, std::stop_token stop) {
     if (auto sent = send_startup(port, sink); !sent) return sent;
-    auto last_rx = Clock::now();
-    auto next_keepalive = Clock::now() + seconds(config_.keepalive_s);
+    auto last_rx = clock_.now();
+    auto next_keepalive = clock_.now() + seconds(config_.keepalive_s);
     // A status reply is the sign of life: the interface answers every keepalive with one,
     // and its three checked bytes (62 22 .. XOR) turn up in noise about once in 16
     // million bytes, where a frame with a valid XOR byte turns up once in 256.
-    ValidFrameWatchdog watchdog(config_.no_valid_frames_s, Clock::now());
+    ValidFrameWatchdog watchdog(config_.no_valid_frames_s, clock_.now());
     std::uint64_t bytes_since_reply = 0;
     const std::uint64_t bad_frames_at_start = decoder_.counters().bad_frames;
     std::uint8_t buffer[256];
     while (!stop.stop_requested()) {
-      const auto wait = std::clamp(duration_cast<milliseconds>(next_sample_ - Clock::now()), milliseconds(0),
-                                   milliseconds(20));
-      auto got = port.read_some(buffer, wait);
+      auto got = port.read_some(buffer, clock_.io_timeout(stop, next_sample_, milliseconds(20)));
       if (!got) return std::unexpected(got.error());
-      const auto now = Clock::now();
+      const auto now = clock_.now();
       if (*got > 0) {
         last_rx = now;
         bytes_since_reply += *got;
@@ -103,7 +98,7 @@ class LenzDriver final : public Driver {
           bytes_since_reply = 0;
         }
       }
-      take(feedback_.expire(now_s()), sink);
+      take(feedback_.expire(clock_.now_s()), sink);
       if (auto sent = ask_held(port, sink); !sent) return sent;
       if (now - last_rx > seconds(config_.link_timeout_s))
         return fail(fmt::format("serial port {}: interface silent for {:.1f} s (no reply to the status request)",
@@ -119,7 +114,7 @@ class LenzDriver final : public Driver {
         if (auto sent = send(port, sink, CommandStationStatusRequest{}); !sent) return sent;
         next_keepalive = now + seconds(config_.keepalive_s);
       }
-      if (now >= next_sample_) publish(sink, reckoner_.estimate(now_s()));
+      if (now >= next_sample_) publish(sink, reckoner_.estimate(clock_.now_s()));
     }
     return {};
   }
@@ -150,7 +145,7 @@ class LenzDriver final : public Driver {
   // Acts on what the feedback reports did: re-runs the reckoner on a change, counts
   // changes dropped as noise, and keeps the nibbles to ask for again (sent by ask_held).
   void take(const FeedbackConfirmation::Outcome& outcome, SampleSink& sink) {
-    if (outcome.changed) reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_.state()), now_s());
+    if (outcome.changed) reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_.state()), clock_.now_s());
     for (const auto& line : outcome.dropped) sink.count_error(fmt::format("{}: {}", config_.port, line));
     to_ask_.insert(to_ask_.end(), outcome.ask.begin(), outcome.ask.end());
   }
@@ -173,7 +168,7 @@ class LenzDriver final : public Driver {
     }
     for (const auto& frame : frames) {
       std::visit(overloaded{
-                     [&](const Feedback& fb) { take(feedback_.apply(fb, reckoner_, now_s()), sink); },
+                     [&](const Feedback& fb) { take(feedback_.apply(fb, reckoner_, clock_.now_s()), sink); },
                      [&](const InterfaceNotice& n) {
                        if (n.code != 0x04 && n.code != 0x07) sink.count_error(describe_notice(n.code));
                      },
@@ -186,21 +181,22 @@ class LenzDriver final : public Driver {
   }
 
   void publish(SampleSink& sink, const AlongTrack& along) {
-    for (const auto& p : train_poses(*config_.layout, along, config_.pose_model, config_.parent_frame, now_us(), last_))
+    for (const auto& p : train_poses(*config_.layout, along, config_.pose_model, config_.parent_frame, clock_.now_us(), last_))
       sink.pose(p);
     next_sample_ += period_;
-    if (next_sample_ < Clock::now()) next_sample_ = Clock::now() + period_;  // fell behind: no burst
+    if (next_sample_ < clock_.now()) next_sample_ = clock_.now() + period_;  // fell behind: no burst
   }
 
   void publish_lost_for(SampleSink& sink, std::stop_token stop, Clock::duration how_long) {
-    const auto end = Clock::now() + how_long;
-    while (Clock::now() < end) {
-      if (!sleep_until(stop, std::min(end, next_sample_))) return;
-      if (Clock::now() >= next_sample_) publish(sink, AlongTrack{});
+    const auto end = clock_.now() + how_long;
+    while (clock_.now() < end) {
+      if (!clock_.sleep_until(stop, std::min(end, next_sample_))) return;
+      if (clock_.now() >= next_sample_) publish(sink, AlongTrack{});
     }
   }
 
   LenzConfig config_;
+  DriverClock& clock_;
   DeadReckoner reckoner_;
   FeedbackConfirmation feedback_;
   std::vector<FeedbackRequest> to_ask_;
@@ -213,6 +209,8 @@ class LenzDriver final : public Driver {
 
 }  // namespace
 
-std::unique_ptr<Driver> make_lenz_driver(const LenzConfig& config) { return std::make_unique<LenzDriver>(config); }
+std::unique_ptr<Driver> make_lenz_driver(const LenzConfig& config, DriverClock& clock) {
+  return std::make_unique<LenzDriver>(config, clock);
+}
 
 }  // namespace covtrack::lenz

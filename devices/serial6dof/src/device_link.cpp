@@ -1,7 +1,5 @@
 #include "device_link.hpp"
 
-#include "covtrack/devices/interruptible_sleep.hpp"
-
 namespace covtrack::serial6dof {
 
 using namespace std::chrono;
@@ -13,8 +11,12 @@ Result<void> DeviceLink::send(std::string_view bytes) {
 }
 
 Result<std::size_t> DeviceLink::read(std::vector<std::uint8_t>& out, milliseconds timeout) {
+  return read_until(out, clock_.now() + timeout);
+}
+
+Result<std::size_t> DeviceLink::read_until(std::vector<std::uint8_t>& out, DriverClock::time_point until) {
   std::uint8_t buffer[4096];
-  auto n = port_.read_some(buffer, timeout);
+  auto n = port_.read_some(buffer, clock_.io_timeout(stop_, until, ceil<milliseconds>(until - clock_.now())));
   if (!n) return n;
   if (*n && publish_raw_) sink_.raw(ByteDirection::FromDevice, buffer, *n);
   out.insert(out.end(), buffer, buffer + *n);
@@ -22,19 +24,23 @@ Result<std::size_t> DeviceLink::read(std::vector<std::uint8_t>& out, millisecond
 }
 
 Result<void> DeviceLink::drain(milliseconds quiet) {
-  const auto give_up = steady_clock::now() + seconds(1);  // a unit still streaming
+  const auto give_up = after(1.0);  // a unit still streaming
+  auto quiet_until = clock_.now() + quiet;
   std::vector<std::uint8_t> discard;
-  while (!stopped() && steady_clock::now() < give_up) {
+  while (!stopped() && clock_.now() < give_up) {
     discard.clear();
-    auto n = read(discard, quiet);
+    auto n = read_until(discard, quiet_until);
     if (!n) return std::unexpected(n.error());
-    if (*n == 0) return {};
+    if (*n > 0) quiet_until = clock_.now() + quiet;
+    else if (clock_.now() >= quiet_until) return {};
   }
   return {};
 }
 
-bool DeviceLink::sleep(double seconds) {
-  return sleep_for(stop_, duration<double>(seconds));
+DriverClock::time_point DeviceLink::after(double seconds) const {
+  return clock_.now() + duration_cast<DriverClock::duration>(duration<double>(seconds));
 }
+
+bool DeviceLink::sleep(double seconds) { return clock_.sleep_until(stop_, after(seconds)); }
 
 }  // namespace covtrack::serial6dof

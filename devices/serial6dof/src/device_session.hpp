@@ -30,9 +30,9 @@ template <typename Accept>
 Result<std::optional<DeviceReply>> await_reply(DeviceLink& link, DeviceSession& session,
                                                 double timeout_s, Accept accept) {
   using namespace std::chrono;
-  const auto deadline = steady_clock::now() + duration_cast<steady_clock::duration>(duration<double>(timeout_s));
+  const auto deadline = link.after(timeout_s);
   std::vector<std::uint8_t> bytes;
-  while (!link.stopped() && steady_clock::now() < deadline) {
+  while (!link.stopped() && link.clock().now() < deadline) {
     bytes.clear();
     auto n = link.read(bytes, milliseconds(20));
     if (!n) return std::unexpected(n.error());

@@ -61,10 +61,8 @@ class FlockSession final : public DeviceSession {
   Result<void> confirm_scaling(DeviceLink& link) {
     if (auto r = link.send(bytes({kExamineValue, kParamPositionScaling})); !r) return r;
     std::vector<std::uint8_t> answer;
-    const auto deadline = std::chrono::steady_clock::now() +
-                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                              std::chrono::duration<double>(config_.reply_timeout_s));
-    while (answer.size() < 2 && !link.stopped() && std::chrono::steady_clock::now() < deadline)
+    const auto deadline = link.after(config_.reply_timeout_s);
+    while (answer.size() < 2 && !link.stopped() && link.clock().now() < deadline)
       if (auto n = link.read(answer, std::chrono::milliseconds(20)); !n) return std::unexpected(n.error());
     if (link.stopped()) return {};
     if (answer.size() < 2)

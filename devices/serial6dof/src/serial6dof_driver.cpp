@@ -10,13 +10,12 @@
 
 #include "covtrack/devices/serial/serial_port.hpp"
 #include "covtrack/devices/serial6dof/covariance_model.hpp"
-#include "covtrack/protocol/clock.hpp"
 #include "device_session.hpp"
 
 namespace covtrack::serial6dof {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using Clock = DriverClock;
 
 // With every station silent this long (and at least this many watchdog periods), the
 // unit is considered stuck and the driver fails so that the restart resets it.
@@ -46,14 +45,14 @@ double seconds_between(Clock::time_point a, Clock::time_point b) {
 
 class Serial6dofDriver final : public Driver {
  public:
-  Serial6dofDriver(const Serial6dofConfig& config, std::uint64_t run_index)
-      : config_(config), spec_(model_spec(config.model)), run_index_(run_index),
+  Serial6dofDriver(const Serial6dofConfig& config, std::uint64_t run_index, DriverClock& clock)
+      : config_(config), spec_(model_spec(config.model)), run_index_(run_index), clock_(clock),
         stations_(config.stations.size(), StationState{MotionGate(config.motion, config.period_s())}) {}
 
   Result<void> run(SampleSink& sink, std::stop_token stop) override {
     auto port = serial::SerialPort::open({.path = config_.port, .baud = config_.baud});
     if (!port) return fail(port.error().message);
-    DeviceLink link(**port, sink, config_.publish_raw, stop);
+    DeviceLink link(**port, sink, config_.publish_raw, stop, clock_);
     auto session = make_session(config_);
     const bool reset = config_.reset_on_start || run_index_ > 0;
     if (auto r = session->start(link, reset); !r) return r;
@@ -64,7 +63,7 @@ class Serial6dofDriver final : public Driver {
  private:
   Result<void> stream(DeviceLink& link, DeviceSession& session, SampleSink& sink) {
     using namespace std::chrono;
-    const auto started = Clock::now();
+    const auto started = clock_.now();
     for (auto& s : stations_) s.last_record = s.last_lost_report = started;
     // Wake often enough to see a silent station within its watchdog time.
     const auto poll = milliseconds(std::clamp<long>(std::lround(config_.watchdog_s() * 250), 1, 20));
@@ -79,8 +78,8 @@ class Serial6dofDriver final : public Driver {
         report_all_lost(sink);
         return fail(fmt::format("{} (stations reported LOST)", n.error().message));
       }
-      const auto now = Clock::now();
-      const std::int64_t time_us = now_us() - std::llround(config_.latency_s * 1e6);
+      const auto now = clock_.now();
+      const std::int64_t time_us = clock_.now_us() - std::llround(config_.latency_s * 1e6);
       const auto items = session.feed(bytes);
       // Records that arrive together were measured one report period apart, the last
       // one just now: a shared receive time would misplace all but the last (and a
@@ -147,12 +146,12 @@ class Serial6dofDriver final : public Driver {
   }
 
   void report_all_lost(SampleSink& sink) {
-    for (std::size_t i = 0; i < stations_.size(); ++i) report_lost(sink, i, Clock::now());
+    for (std::size_t i = 0; i < stations_.size(); ++i) report_lost(sink, i, clock_.now());
   }
 
   void report_lost(SampleSink& sink, std::size_t i, Clock::time_point now) {
     const auto& st = config_.stations[i];
-    PoseSample s{st.name, config_.parent_frame, st.name, now_us()};
+    PoseSample s{st.name, config_.parent_frame, st.name, clock_.now_us()};
     s.status = TrackingStatus::Lost;  // LOST carries no information: infinite covariance
     s.T_parent_child = stations_[i].last_estimate;
     s.covariance = lost_covariance();
@@ -164,13 +163,15 @@ class Serial6dofDriver final : public Driver {
   Serial6dofConfig config_;
   const ModelSpec& spec_;
   std::uint64_t run_index_;
+  DriverClock& clock_;
   std::vector<StationState> stations_;
 };
 
 }  // namespace
 
-std::unique_ptr<Driver> make_serial6dof_driver(const Serial6dofConfig& config, std::uint64_t run_index) {
-  return std::make_unique<Serial6dofDriver>(config, run_index);
+std::unique_ptr<Driver> make_serial6dof_driver(const Serial6dofConfig& config, std::uint64_t run_index,
+                                               DriverClock& clock) {
+  return std::make_unique<Serial6dofDriver>(config, run_index, clock);
 }
 
 }  // namespace covtrack::serial6dof

@@ -4,11 +4,9 @@
 #include <numbers>
 #include <random>
 
-#include "covtrack/devices/interruptible_sleep.hpp"
 #include "covtrack/devices/serial/pseudo_terminal.hpp"
 #include "covtrack/devices/serial6dof/covariance_model.hpp"
 #include "covtrack/devices/sim/se3_gaussian.hpp"
-#include "covtrack/protocol/clock.hpp"
 #include "emulated_unit.hpp"
 #include "line_noise.hpp"
 #include "sway.hpp"
@@ -17,7 +15,7 @@ namespace covtrack::emulate6dof {
 
 using namespace std::chrono;
 using namespace serial6dof;
-using Clock = steady_clock;
+using Clock = DriverClock;
 
 std::vector<EmulatedStation> default_stations(const std::vector<int>& numbers) {
   std::vector<EmulatedStation> out;
@@ -37,8 +35,8 @@ std::vector<EmulatedStation> default_stations(const std::vector<int>& numbers) {
 
 class Emulator::Impl {
  public:
-  Impl(const EmulatorConfig& c, serial::PseudoTerminal pty)
-      : config_(c), spec_(model_spec(c.model)), pty_(std::move(pty)), rng_(c.seed),
+  Impl(const EmulatorConfig& c, serial::PseudoTerminal pty, DriverClock& clock)
+      : config_(c), spec_(model_spec(c.model)), clock_(clock), pty_(std::move(pty)), rng_(c.seed),
         noise_rng_(c.seed ^ 0x6e6f697365ull),
         noise_{c.bit_flips_per_s, c.bytes_dropped_per_s, c.bytes_duplicated_per_s} {
     if (config_.rate_hz <= 0)
@@ -53,23 +51,22 @@ class Emulator::Impl {
 
   void run(Emulator& e, std::stop_token stop, const TruthCallback& on_truth) {
     const auto period = duration_cast<Clock::duration>(duration<double>(1.0 / config_.rate_hz));
-    auto next_report = Clock::now() + period;
+    auto next_report = clock_.now() + period;
     auto reset_done = Clock::time_point::min();
-    auto next_trouble = Clock::now() + duration_cast<Clock::duration>(duration<double>(config_.trouble_every_s));
+    auto next_trouble = clock_.now() + duration_cast<Clock::duration>(duration<double>(config_.trouble_every_s));
     std::vector<std::uint8_t> input;
     Bytes reply;
 
     while (!stop.stop_requested()) {
       if (!follow_plug(e)) {
-        sleep_for(stop, milliseconds(5));
+        clock_.sleep_until(stop, clock_.now() + milliseconds(5));
         continue;
       }
-      const auto now = Clock::now();
+      const auto now = clock_.now();
       const bool resetting = now < reset_done;
       e.resetting_ = resetting;
       std::uint8_t buffer[1024];
-      const auto wait = std::clamp(duration_cast<milliseconds>(next_report - now), milliseconds(0), milliseconds(5));
-      auto n = pty_.read_some(buffer, wait);
+      auto n = pty_.read_some(buffer, clock_.io_timeout(stop, next_report, milliseconds(5)));
       if (n && *n && !resetting) {  // a resetting unit does not listen
         input.insert(input.end(), buffer, buffer + *n);
         reply.clear();
@@ -77,18 +74,18 @@ class Emulator::Impl {
           input.clear();
           unit_->power_on();
           e.hung_ = false;
-          reset_done = Clock::now() + duration_cast<Clock::duration>(duration<double>(config_.reset_time_s));
+          reset_done = clock_.now() + duration_cast<Clock::duration>(duration<double>(config_.reset_time_s));
           ++e.resets_;
         }
         if (!reply.empty()) (void)pty_.write(reply);
       }
-      if (Clock::now() < next_report) continue;
+      if (clock_.now() < next_report) continue;
       const auto sampled = next_report;  // a real unit samples on its own clock, late or not
       next_report += period;
-      if (Clock::now() > next_report + 10 * period) next_report = Clock::now() + period;  // stalled
+      if (clock_.now() > next_report + 10 * period) next_report = clock_.now() + period;  // stalled
       if (resetting || e.hung_ || !unit_->streaming()) continue;
       bool trouble = false;
-      if (config_.trouble_every_s > 0 && unit_->trouble_code() >= 0 && Clock::now() >= next_trouble) {
+      if (config_.trouble_every_s > 0 && unit_->trouble_code() >= 0 && clock_.now() >= next_trouble) {
         trouble = true;
         next_trouble += duration_cast<Clock::duration>(duration<double>(config_.trouble_every_s));
       }
@@ -114,7 +111,7 @@ class Emulator::Impl {
   }
 
   void report(Emulator& e, bool trouble, const TruthCallback& on_truth, Clock::time_point sampled) {
-    const std::int64_t time_us = now_us() - duration_cast<microseconds>(Clock::now() - sampled).count();
+    const std::int64_t time_us = clock_.now_us() - duration_cast<microseconds>(clock_.now() - sampled).count();
     const double t_s = duration<double>(sampled - started_).count();
     std::vector<TrackerRecord> records;
     for (std::size_t i = 0; i < config_.stations.size(); ++i) {
@@ -150,21 +147,22 @@ class Emulator::Impl {
 
   EmulatorConfig config_;
   const ModelSpec& spec_;
+  DriverClock& clock_;
   serial::PseudoTerminal pty_;
   std::unique_ptr<EmulatedUnit> unit_;
   std::mt19937_64 rng_;
   std::mt19937_64 noise_rng_;  // apart from rng_: the same seed gives the same pose noise
   LineNoiseRates noise_;
-  Clock::time_point started_ = Clock::now();
+  Clock::time_point started_ = clock_.now();
   double last_sent_s_ = 0;
 };
 
-Result<std::unique_ptr<Emulator>> Emulator::create(const EmulatorConfig& config) {
+Result<std::unique_ptr<Emulator>> Emulator::create(const EmulatorConfig& config, DriverClock& clock) {
   if (config.stations.empty()) return fail("emulator: no stations configured");
   auto pty = serial::PseudoTerminal::create(config.link_path);
   if (!pty) return fail("emulator: " + pty.error().message);
   const std::string path = pty->device_path();
-  auto e = std::unique_ptr<Emulator>(new Emulator(std::make_unique<Impl>(config, std::move(*pty))));
+  auto e = std::unique_ptr<Emulator>(new Emulator(std::make_unique<Impl>(config, std::move(*pty), clock)));
   e->device_path_ = path;
   return e;
 }

@@ -2,9 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <thread>
-
-#include "covtrack/protocol/clock.hpp"
 
 namespace covtrack::lenz {
 namespace {
@@ -18,7 +15,7 @@ constexpr std::size_t kMaxPairsPerMessage = 7;  // header nibble 14 data bytes
 
 }  // namespace
 
-Result<std::unique_ptr<LenzEmulator>> LenzEmulator::create(LenzEmulatorOptions options) {
+Result<std::unique_ptr<LenzEmulator>> LenzEmulator::create(LenzEmulatorOptions options, DriverClock& clock) {
   if (!options.layout) return fail("lenz emulator: no layout");
   if (options.accel_mps2 <= 0) options.accel_mps2 = 0.8 * options.layout->train().max_accel_mps2;
   const Train& train = options.layout->train();
@@ -29,14 +26,15 @@ Result<std::unique_ptr<LenzEmulator>> LenzEmulator::create(LenzEmulatorOptions o
   }
   auto pty = serial::PseudoTerminal::create(options.link_path);
   if (!pty) return std::unexpected(pty.error());
-  return std::unique_ptr<LenzEmulator>(new LenzEmulator(std::move(options), std::move(*pty)));
+  return std::unique_ptr<LenzEmulator>(new LenzEmulator(std::move(options), std::move(*pty), clock));
 }
 
-LenzEmulator::LenzEmulator(LenzEmulatorOptions options, serial::PseudoTerminal pty)
+LenzEmulator::LenzEmulator(LenzEmulatorOptions options, serial::PseudoTerminal pty, DriverClock& clock)
     : options_(std::move(options)),
+      clock_(clock),
       pty_(std::move(pty)),
       motion_(options_.profile, options_.accel_mps2, options_.start_s),
-      start_us_(now_us()) {
+      start_us_(clock.now_us()) {
   for (const auto& s : options_.layout->sections()) module_inputs_[s.input.module] = 0;
   occupied_section_ = options_.layout->section_at(options_.start_s);
   const auto& in = options_.layout->sections()[occupied_section_].input;
@@ -135,7 +133,8 @@ void LenzEmulator::run(std::stop_token stop, const std::function<void(const Trut
   using namespace std::chrono;
   const auto tick = milliseconds(std::max<std::int64_t>(1, std::llround(options_.tick_s * 1000)));
   const std::int64_t truth_period_us = std::llround(1e6 / options_.truth_hz);
-  std::int64_t next_truth_us = now_us();
+  std::int64_t next_truth_us = clock_.now_us();
+  auto next_tick = clock_.now();
   std::uint8_t buffer[256];
   while (!stop.stop_requested()) {
     if (want_plugged_ != pty_.plugged()) {
@@ -146,12 +145,13 @@ void LenzEmulator::run(std::stop_token stop, const std::function<void(const Trut
       }
     }
     if (pty_.plugged()) {
-      auto got = pty_.read_some(buffer, tick);
+      auto got = pty_.read_some(buffer, clock_.io_timeout(stop, next_tick, tick));
       if (got && *got > 0)
         for (const auto& frame : decoder_.push({buffer, *got})) answer(frame);
-    } else {
-      std::this_thread::sleep_for(tick);
+    } else if (!clock_.sleep_until(stop, next_tick)) {
+      break;
     }
+    next_tick = clock_.now() + tick;
     std::vector<FeedbackPair> forged;
     {
       std::lock_guard lock(forged_mutex_);
@@ -159,7 +159,7 @@ void LenzEmulator::run(std::stop_token stop, const std::function<void(const Trut
     }
     for (const auto& pair : forged)
       if (pty_.plugged()) send(Feedback{{pair}}, Prefix::Unsolicited);
-    const std::int64_t t_us = now_us();
+    const std::int64_t t_us = clock_.now_us();
     const double s = true_s_at(t_us);
     update_occupancy(s);
     if (truth && t_us >= next_truth_us) {

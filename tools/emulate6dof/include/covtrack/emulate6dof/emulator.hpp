@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "covtrack/devices/driver.hpp"
+#include "covtrack/devices/driver_clock.hpp"
 #include "covtrack/devices/serial6dof/device_model.hpp"
 
 namespace covtrack::emulate6dof {
@@ -52,8 +53,9 @@ class Emulator {
  public:
   using TruthCallback = std::function<void(const TruthSample&)>;
 
-  // Creates the pseudo-terminal; the thread starts with start().
-  static Result<std::unique_ptr<Emulator>> create(const EmulatorConfig& config);
+  // Creates the pseudo-terminal; the thread starts with start(). The unit streams,
+  // resets and stamps its truth on `clock`'s time.
+  static Result<std::unique_ptr<Emulator>> create(const EmulatorConfig& config, DriverClock& clock = real_clock());
   ~Emulator();
 
   void start(TruthCallback on_truth);

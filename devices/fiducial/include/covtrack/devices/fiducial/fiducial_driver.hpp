@@ -6,10 +6,13 @@
 #include <memory>
 
 #include "covtrack/devices/driver.hpp"
+#include "covtrack/devices/driver_clock.hpp"
 #include "covtrack/devices/fiducial/fiducial_config.hpp"
 
 namespace covtrack::fiducial {
 
-std::unique_ptr<Driver> make_fiducial_driver(const FiducialConfig& config, std::uint64_t run_index);
+// A file source is paced, and every frame stamped, on `clock`.
+std::unique_ptr<Driver> make_fiducial_driver(const FiducialConfig& config, std::uint64_t run_index,
+                                             DriverClock& clock = real_clock());
 
 }  // namespace covtrack::fiducial

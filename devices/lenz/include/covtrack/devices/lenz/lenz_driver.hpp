@@ -13,10 +13,13 @@
 #include <memory>
 
 #include "covtrack/devices/driver.hpp"
+#include "covtrack/devices/driver_clock.hpp"
 #include "covtrack/devices/lenz/lenz_config.hpp"
 
 namespace covtrack::lenz {
 
-std::unique_ptr<Driver> make_lenz_driver(const LenzConfig& config);
+// Every time the driver works with (keepalives, timeouts, the sample schedule, dead
+// reckoning, the stamps on its poses) comes from `clock`.
+std::unique_ptr<Driver> make_lenz_driver(const LenzConfig& config, DriverClock& clock = real_clock());
 
 }  // namespace covtrack::lenz

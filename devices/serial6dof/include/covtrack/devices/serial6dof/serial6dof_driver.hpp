@@ -8,10 +8,13 @@
 #include <memory>
 
 #include "covtrack/devices/driver.hpp"
+#include "covtrack/devices/driver_clock.hpp"
 #include "covtrack/devices/serial6dof/serial6dof_config.hpp"
 
 namespace covtrack::serial6dof {
 
-std::unique_ptr<Driver> make_serial6dof_driver(const Serial6dofConfig& config, std::uint64_t run_index);
+// Every wait, timeout and time stamp of the driver is on `clock`.
+std::unique_ptr<Driver> make_serial6dof_driver(const Serial6dofConfig& config, std::uint64_t run_index,
+                                               DriverClock& clock = real_clock());
 
 }  // namespace covtrack::serial6dof

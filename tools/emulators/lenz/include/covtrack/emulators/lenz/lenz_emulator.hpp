@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "covtrack/devices/driver.hpp"
+#include "covtrack/devices/driver_clock.hpp"
 #include "covtrack/devices/lenz/lenz_config.hpp"
 #include "covtrack/devices/lenz/track_layout.hpp"
 #include "covtrack/devices/lenz/xpressnet_framing.hpp"
@@ -39,14 +40,15 @@ struct LenzEmulatorOptions {
 
 class LenzEmulator {
  public:
-  static Result<std::unique_ptr<LenzEmulator>> create(LenzEmulatorOptions options);
+  // The train moves, and occupancy is evaluated, on `clock`'s time.
+  static Result<std::unique_ptr<LenzEmulator>> create(LenzEmulatorOptions options, DriverClock& clock = real_clock());
 
   // The path a driver's `port` should name.
   std::string device_path() const { return pty_.device_path(); }
   std::string slave_path() const { return pty_.slave_path(); }
   const TrainMotion& motion() const { return motion_; }
   const TrackLayout& layout() const { return *options_.layout; }
-  // now_us() of the train's t = 0: the locomotive is at motion().s_at(now - start).
+  // The clock's now_us() at the train's t = 0: the locomotive is at motion().s_at(now - start).
   std::int64_t start_time_us() const { return start_us_; }
   double true_s_at(std::int64_t time_us) const;
 
@@ -63,7 +65,7 @@ class LenzEmulator {
   std::uint64_t broadcasts_sent() const { return broadcasts_sent_; }
 
  private:
-  LenzEmulator(LenzEmulatorOptions options, serial::PseudoTerminal pty);
+  LenzEmulator(LenzEmulatorOptions options, serial::PseudoTerminal pty, DriverClock& clock);
   void answer(const Frame& frame);
   void send(const Reply& reply, Prefix prefix);
   void update_occupancy(double s);
@@ -71,6 +73,7 @@ class LenzEmulator {
   void publish_truth(const std::function<void(const TruthSample&)>& truth, std::int64_t time_us, double s);
 
   LenzEmulatorOptions options_;
+  DriverClock& clock_;
   serial::PseudoTerminal pty_;
   TrainMotion motion_;
   FrameDecoder decoder_;
