@@ -128,6 +128,7 @@ int run_view(const ViewArgs& args) {
     auto sub = client::Subscriber::open({.lcm_url = args.lcm_url});
     if (!sub) return fail_with(sub.error().message, program::kExitRuntimeError);
     subscriber = std::move(*sub);
+    std::cerr << receive_buffer_warning(*subscriber, "covtrack view: ");
     // Streams the scene does not use are simply not in the graph.
     (void)subscriber->on_pose(".*", [&](const client::TrackedTransform& t) { mismatches.update(graph, t); });
     latest_report = [&subscriber](const StreamId& id) { return subscriber->latest(id); };
