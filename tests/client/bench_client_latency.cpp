@@ -1,5 +1,6 @@
 // Receive paths compared in one run, run by hand inside a network namespace:
 //   tests/netns_run.sh build/tests/client/bench_client_latency [seconds per run, default 2] [rounds, default 3]
+//                                                               [one receiver's name, to profile it alone]
 // One lcm::LCM publisher sends pose messages of 10 streams at 10, 20, 50 and 100 kHz
 // aggregate (paced every 100 us, so a few messages leave together at the higher rates);
 // each receiver, with its own default settings, measures one-way latency (publish_time_us
@@ -181,6 +182,7 @@ long rmem(const char* name) {
 int main(int argc, char** argv) {
   const double seconds = argc > 1 ? std::atof(argv[1]) : 2.0;
   const int rounds = argc > 2 ? std::atoi(argv[2]) : 3;
+  const std::string only = argc > 3 ? argv[3] : "";
   std::printf("LCM URL %s; net.core.rmem_default %ld, rmem_max %ld bytes\n", kUrl.c_str(), rmem("rmem_default"),
               rmem("rmem_max"));
   if (auto s = client::Subscriber::open({.lcm_url = kUrl}); s && (*s)->receive_buffer())
@@ -193,14 +195,16 @@ int main(int argc, char** argv) {
               "p99/raw", "received", "lost");
   for (double rate : {10'000.0, 20'000.0, 50'000.0, 100'000.0}) {
     Tally t[4];
+    const auto run = [&](int i) { return only.empty() || only == names[i]; };
     for (int round = 0; round < rounds; ++round) {
-      raw_lcm(t[0], rate, seconds);
-      bare_udp(t[1], rate, seconds);
-      subscriber(t[2], rate, seconds, false);
-      subscriber(t[3], rate, seconds, true);
+      if (run(0)) raw_lcm(t[0], rate, seconds);
+      if (run(1)) bare_udp(t[1], rate, seconds);
+      if (run(2)) subscriber(t[2], rate, seconds, false);
+      if (run(3)) subscriber(t[3], rate, seconds, true);
     }
     const Percentiles raw = percentiles(t[0].latency_us);
     for (int i = 0; i < 4; ++i) {
+      if (!run(i)) continue;
       const Percentiles p = percentiles(t[i].latency_us);
       std::printf("%9.0f  %-12s %9.1f %9.1f %9.2f %9.2f %10ld %10ld (%.3f%%)\n", rate, names[i], p.p50, p.p99,
                   p.p50 / raw.p50, p.p99 / raw.p99, static_cast<long>(t[i].received),

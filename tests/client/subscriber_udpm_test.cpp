@@ -3,8 +3,6 @@
 // a pose larger than one datagram, a datagram that is not LCM's, and no loss in a burst
 // the default receive buffer is sized for (counted, not timed).
 #include <gtest/gtest.h>
-#include <arpa/inet.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <string>
@@ -16,6 +14,7 @@
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "pose_messages.hpp"
+#include "raw_datagram.hpp"
 
 using namespace covtrack;
 using namespace std::chrono_literals;
@@ -73,16 +72,8 @@ TEST(SubscriberUdpm, APoseInFragmentsIsReassembledAndChecked) {
 TEST(SubscriberUdpm, ADatagramThatIsNotLcmsIsCountedAsRejected) {
   auto sub = open(url(7772));
   ASSERT_TRUE(sub);
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  ASSERT_GE(fd, 0);
-  sockaddr_in group{};
-  group.sin_family = AF_INET;
-  group.sin_port = htons(7772);
-  ::inet_pton(AF_INET, "239.255.76.67", &group.sin_addr);
   const char fragment_without_count[] = "LC03\0\0\0\1\0\0\0\x10\0\0\0\0\0\0\0\0chan";  // fragment 0 of 0
-  ASSERT_GT(::sendto(fd, fragment_without_count, sizeof fragment_without_count, 0,
-                     reinterpret_cast<const sockaddr*>(&group), sizeof group), 0);
-  ::close(fd);
+  ASSERT_TRUE(test::send_datagram("239.255.76.67", 7772, fragment_without_count, sizeof fragment_without_count));
   ASSERT_TRUE(eventually([&] { return sub->rejections().total == 1; }));
   EXPECT_EQ(sub->rejections().by_reason.count("bad fragment number"), 1u) << sub->rejections().summary();
 }

@@ -3,9 +3,7 @@
 // lcm::LCM sends them, a datagram that is not LCM's, another group on the same port, and
 // the URL's options.
 #include <gtest/gtest.h>
-#include <arpa/inet.h>
 #include <poll.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <fstream>
@@ -16,6 +14,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "raw_datagram.hpp"
 #include "udpm_receiver.hpp"  // client/src: the receiver is internal to the Subscriber
 
 using namespace covtrack;
@@ -122,16 +121,8 @@ TEST(UdpmReceiver, FragmentedMessagesFromLcmAreReassembled) {
 TEST(UdpmReceiver, ADatagramThatIsNotLcmsIsReportedAndReceivingGoesOn) {
   auto r = open_receiver(url(7762));
   ASSERT_TRUE(r);
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  ASSERT_GE(fd, 0);
-  sockaddr_in group{};
-  group.sin_family = AF_INET;
-  group.sin_port = htons(7762);
-  ::inet_pton(AF_INET, "239.255.76.67", &group.sin_addr);
   const char junk[] = "NOT-LCM at all";
-  ASSERT_EQ(::sendto(fd, junk, sizeof junk, 0, reinterpret_cast<const sockaddr*>(&group), sizeof group),
-            static_cast<ssize_t>(sizeof junk));
-  ::close(fd);
+  ASSERT_TRUE(test::send_datagram("239.255.76.67", 7762, junk, sizeof junk));
   lcm::LCM lcm(url(7762));
   const Bytes payload = random_bytes(100, 1);
   lcm.publish("rx/after", payload.data(), static_cast<unsigned>(payload.size()));
