@@ -172,17 +172,6 @@ Polygon intersect_convex(const Polygon& a, const Polygon& b) {
   return simplify(out);
 }
 
-Polygon intersect_convex_by_clipping(const Polygon& a, const Polygon& b) {
-  if (a.size() < 3 || b.size() < 3) return {};
-  Polygon out = a;
-  for (std::size_t i = 0, n = b.size(); i < n && !out.empty(); ++i) {
-    const Vec2 e = b[(i + 1) % n] - b[i];
-    const Vec2 outward(e.y(), -e.x());  // counter-clockwise: the interior is on the left
-    out = clip_half_plane(out, outward, outward.dot(b[i]));
-  }
-  return simplify(out);
-}
-
 Vec2 polygon_centroid(const Polygon& p) {
   if (p.empty()) return Vec2::Zero();
   Vec2 mean = Vec2::Zero();

@@ -1,7 +1,9 @@
 #include "covtrack/client/label_placer.hpp"
 
+#include <algorithm>
 #include <cmath>
 
+#include "box_grid.hpp"
 #include "covtrack/client/convex_polygon.hpp"
 #include "covtrack/client/space_manager.hpp"
 
@@ -17,10 +19,8 @@ bool box_inside_convex(const Box& box, const Polygon& convex) {
   return true;
 }
 
-bool clear_of(const Box& box, std::span<const Box> placed) {
-  for (const Box& other : placed)
-    if (boxes_overlap(box, other)) return false;
-  return true;
+bool clear_of(const Box& box, const BoxGrid& placed) {
+  return !placed.any_near(box, [&](std::size_t i) { return boxes_overlap(box, placed.boxes()[i]); });
 }
 
 Vec2 sane_size(const Vec2& size) {
@@ -29,7 +29,7 @@ Vec2 sane_size(const Vec2& size) {
 }
 
 std::optional<Box> place_inside(const Polygon& inner, const Vec2& size, const Box& screen,
-                                std::span<const Box> placed) {
+                                const BoxGrid& placed) {
   const Polygon centers = feasible_label_centers(inner, size, screen);
   if (centers.empty()) return std::nullopt;
   // The middle of the feasible centres first (the label sits well inside), then its
@@ -45,30 +45,21 @@ std::optional<Box> place_inside(const Polygon& inner, const Vec2& size, const Bo
   return std::nullopt;
 }
 
-// Other objects' outer regions, with their bounding boxes for a cheap first test.
+// Objects' outer regions, filed by their bounding boxes.
 struct Obstacles {
   std::vector<const Polygon*> regions;
-  std::vector<Box> bounds;
+  BoxGrid bounds;
 };
 
 std::optional<Box> place_outside(const Polygon& outer, const Vec2& size, const LabelPlacerOptions& o,
-                                 std::span<const Box> placed, const Obstacles& others) {
+                                 const BoxGrid& placed, const Obstacles& objects) {
   if (!o.policy) return std::nullopt;
   const std::vector<Box> candidates = o.policy(bounding_box(outer), size, o.screen, o.gap_px);
-  // Only the objects near some candidate can be hidden by one.
-  std::vector<std::size_t> near;
-  if (o.avoid_other_objects && !candidates.empty()) {
-    Box reach = candidates.front();
-    for (const Box& box : candidates) reach.min = reach.min.cwiseMin(box.min), reach.max = reach.max.cwiseMax(box.max);
-    for (std::size_t k = 0; k < others.regions.size(); ++k)
-      if (others.regions[k] != &outer && boxes_overlap(reach, others.bounds[k]))
-        near.push_back(k);
-  }
   const auto hides_another = [&](const Box& box) {
-    for (std::size_t k : near)
-      if (boxes_overlap(box, others.bounds[k]) && box_meets_convex(box, *others.regions[k]))
-        return true;
-    return false;
+    return o.avoid_other_objects && objects.bounds.any_near(box, [&](std::size_t k) {
+      return objects.regions[k] != &outer && boxes_overlap(box, objects.bounds.boxes()[k]) &&
+             box_meets_convex(box, *objects.regions[k]);
+    });
   };
   // The first place that hides no other object either; failing that, the first one
   // clear of its own object.
@@ -118,7 +109,9 @@ std::vector<PlacedLabel> place_labels(std::span<const LabelRequest> requests,
   const std::size_t n = requests.size();
   std::vector<PlacedLabel> labels(n);
   std::vector<bool> done(n, false);
-  std::vector<Box> placed;
+  // Cells about the size of a label when the screen is full of objects.
+  const int cells = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(n))), 1, 64);
+  BoxGrid placed(o.screen, cells);
   // Inside labels first: they are the most constrained, and an outside label must not
   // take the space an inner region offers.
   if (o.allow_inside) {
@@ -127,22 +120,22 @@ std::vector<PlacedLabel> place_labels(std::span<const LabelRequest> requests,
       const Vec2 size = sane_size(requests[i].size_px);
       if (auto box = place_inside(requests[i].inner, size, o.screen, placed)) {
         labels[i] = {*box, LabelPlacement::inside_inner, true, std::nullopt, true};
-        placed.push_back(*box);
+        placed.insert(*box);
         done[i] = true;
       }
     }
   }
-  Obstacles others;
+  Obstacles objects{{}, BoxGrid(o.screen, cells)};
   if (o.avoid_other_objects)
     for (const LabelRequest& r : requests)
-      if (is_usable_polygon(r.outer)) others.regions.push_back(&r.outer), others.bounds.push_back(bounding_box(r.outer));
+      if (is_usable_polygon(r.outer)) objects.regions.push_back(&r.outer), objects.bounds.insert(bounding_box(r.outer));
   for (std::size_t i = 0; i < n; ++i) {
     if (done[i] || !is_usable_polygon(requests[i].outer)) continue;
     const Vec2 size = sane_size(requests[i].size_px);
-    if (auto box = place_outside(requests[i].outer, size, o, placed, others)) {
+    if (auto box = place_outside(requests[i].outer, size, o, placed, objects)) {
       labels[i] = {*box, LabelPlacement::outside_outer, true, leader_to(*box, requests[i].outer),
                    true};
-      placed.push_back(*box);
+      placed.insert(*box);
       done[i] = true;
     }
   }
@@ -150,7 +143,7 @@ std::vector<PlacedLabel> place_labels(std::span<const LabelRequest> requests,
   std::vector<Vec2> sizes;
   for (std::size_t i = 0; i < n; ++i)
     if (!done[i]) rest.push_back(i), sizes.push_back(sane_size(requests[i].size_px));
-  const std::vector<Box> list = stack_in_corner(sizes, placed, o.screen, o.gap_px);
+  const std::vector<Box> list = stack_in_corner(sizes, placed.boxes(), o.screen, o.gap_px);
   for (std::size_t k = 0; k < rest.size(); ++k) {
     PlacedLabel& label = labels[rest[k]];
     label.box = list[k];

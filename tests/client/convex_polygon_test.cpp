@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "covtrack/client/convex_polygon.hpp"
+#include "support/convex_clipping.hpp"
 #include "widget_polygons.hpp"
 
 using namespace covtrack::client;
@@ -61,7 +62,7 @@ TEST(ConvexIntersection, EqualsClippingOnRandomConvexPolygons) {
     if (grid) shift = shift.array().round().matrix();
     const Polygon b = widget_testing::random_convex(rng, shift, 1 + trial % 10, 25, grid);
     const Polygon fast = intersect_convex(a, b);
-    const Polygon slow = intersect_convex_by_clipping(a, b);
+    const Polygon slow = reference::intersect_convex_by_clipping(a, b);
     const double area = polygon_area(slow);
     ASSERT_NEAR(polygon_area(fast), area, 1e-9 * (1 + area))
         << "trial " << trial << "\na: " << text(a) << "\nb: " << text(b);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "covtrack/client/convex_polygon.hpp"
+#include "support/convex_clipping.hpp"
 #include "covtrack/client/label_placer.hpp"
 #include "covtrack/client/space_manager.hpp"
 #include "widget_polygons.hpp"
@@ -30,7 +31,7 @@ Polygon shrunk(const Polygon& p, double factor) {
 
 // Independent of the placer's own tests: area the box cuts out of the polygon.
 double shared_area(const Box& box, const Polygon& convex) {
-  return polygon_area(intersect_convex_by_clipping(convex, box_polygon(box)));
+  return polygon_area(reference::intersect_convex_by_clipping(convex, box_polygon(box)));
 }
 
 bool corners_inside(const Box& box, const Polygon& convex) {

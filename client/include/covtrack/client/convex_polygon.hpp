@@ -1,7 +1,8 @@
 #pragma once
 // Convex polygon operations the widgets need beyond regions.hpp: intersection in linear
-// time, its slow reference, centroid. Polygons as in regions.hpp: counter-clockwise
-// (positive signed area), no repeated closing vertex.
+// time, centroid. Polygons as in regions.hpp: counter-clockwise (positive signed area), no
+// repeated closing vertex. (The slow reference the intersection is tested against is in
+// tests/support.)
 #include "covtrack/client/regions.hpp"
 
 namespace covtrack::client {
@@ -12,9 +13,6 @@ namespace covtrack::client {
 // and there the intersection is max(lower chains) <= y <= min(upper chains). Empty when
 // the interiors do not meet or an input has fewer than 3 vertices.
 Polygon intersect_convex(const Polygon& a, const Polygon& b);
-
-// The same by clipping `a` with every edge's half-plane of `b`: O(n m), the reference.
-Polygon intersect_convex_by_clipping(const Polygon& a, const Polygon& b);
 
 // Area centroid; the vertex mean when the area is zero; (0, 0) when empty.
 Vec2 polygon_centroid(const Polygon& polygon);

@@ -17,8 +17,11 @@ struct Box {
 Box box_at_center(const Vec2& center_px, const Vec2& size_px);
 Box box_at_corner(const Vec2& min_px, const Vec2& size_px);
 
-// Interiors meet (boxes that only touch along an edge do not overlap).
-bool boxes_overlap(const Box& a, const Box& b);
+// Interiors meet (boxes that only touch along an edge do not overlap). Inline: the label
+// placer and the space manager test many pairs.
+inline bool boxes_overlap(const Box& a, const Box& b) {
+  return a.min.x() < b.max.x() && b.min.x() < a.max.x() && a.min.y() < b.max.y() && b.min.y() < a.max.y();
+}
 // `inner` lies within `outer` (within tolerance_px).
 bool box_inside(const Box& inner, const Box& outer, double tolerance_px = 1e-9);
 // The box as a counter-clockwise polygon.
