@@ -12,6 +12,7 @@ packages=(build-essential cmake pkg-config liblcm-dev liblcm-bin libeigen3-dev
           libapriltag-dev libqhull-dev libserial-dev libusb-1.0-0-dev libhidapi-dev xvfb xauth
           iproute2 util-linux python3-dev pybind11-dev python3-numpy python3-pytest
           default-jdk-headless liblcm-java libjchart2d-java
+          libopenscenegraph-dev libgl1-mesa-dri  # the 3-D AR adapter; Mesa draws its tests
           file)  # file: cpack -G DEB finds the ELF files for dpkg-shlibdeps with it
 missing=()
 for p in "${packages[@]}"; do

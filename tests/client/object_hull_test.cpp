@@ -1,6 +1,7 @@
 // The 3-D hull of an object's vertices: which points it keeps, flat and degenerate sets,
 // bad input, and the reason it exists: projecting only the hull loses no screen hull point.
 #include <algorithm>
+#include <map>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -96,4 +97,44 @@ TEST(ObjectHull, ProjectingTheHullLosesNoScreenHullPointThroughAPinhole) {
       EXPECT_TRUE(std::binary_search(ids->begin(), ids->end(), i))
           << "screen hull point " << i << " is not a 3-D hull vertex (trial " << trial << ")";
   }
+}
+
+// The hull's triangles close a surface around every point, facing out: each edge is used
+// once in each direction, every point is behind every triangle's plane, and the enclosed
+// volume (divergence theorem) is the box's.
+TEST(ObjectHull, TrianglesCloseTheHullFacingOut) {
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> g;
+  std::vector<Vec3> points;
+  for (int i = 0; i < 300; ++i) points.push_back(Vec3(g(rng), g(rng), 0.5 * g(rng)));
+  auto triangles = convex_hull_triangles_3d(points);
+  ASSERT_TRUE(triangles) << triangles.error().message;
+  ASSERT_GE(triangles->size(), 4u);
+  std::map<std::pair<int, int>, int> edges;
+  for (const Triangle& t : *triangles) {
+    const Vec3 n = (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]);
+    for (const Vec3& p : points) EXPECT_LE(n.dot(p - points[t[0]]), 1e-9 * n.norm());
+    for (int k = 0; k < 3; ++k) ++edges[{t[k], t[(k + 1) % 3]}];
+  }
+  for (const auto& [edge, count] : edges) {
+    EXPECT_EQ(count, 1);
+    EXPECT_EQ(edges.count({edge.second, edge.first}), 1u) << edge.first << "-" << edge.second;
+  }
+
+  std::vector<Vec3> box;
+  for (int i = 0; i < 8; ++i) box.emplace_back(i & 1 ? 0.04 : -0.04, i & 2 ? 0.03 : -0.03, i & 4 ? 0.02 : -0.02);
+  box.push_back(Vec3(0.01, 0, 0));  // inside: left out
+  auto box_triangles = convex_hull_triangles_3d(box);
+  ASSERT_TRUE(box_triangles);
+  EXPECT_EQ(box_triangles->size(), 12u);
+  double volume = 0;
+  for (const Triangle& t : *box_triangles) volume += box[t[0]].dot(box[t[1]].cross(box[t[2]])) / 6;
+  EXPECT_NEAR(volume, 0.08 * 0.06 * 0.04, 1e-12);
+
+  // A flat quad: a fan of two; a line: none.
+  const std::vector<Vec3> quad = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)};
+  EXPECT_EQ(convex_hull_triangles_3d(quad)->size(), 2u);
+  const std::vector<Vec3> line = {Vec3(0, 0, 0), Vec3(1, 1, 1), Vec3(2, 2, 2)};
+  EXPECT_TRUE(convex_hull_triangles_3d(line)->empty());
+  EXPECT_FALSE(convex_hull_triangles_3d({}));
 }

@@ -7,6 +7,7 @@
 #include "covtrack/client/ar_view.hpp"
 #include "covtrack/scene/scene_graph.hpp"
 #include "regions_report.hpp"
+#include "scene_ar_view.hpp"
 #include "view_labels.hpp"
 #include "view_widgets.hpp"
 
@@ -15,25 +16,9 @@ using namespace covtrack::cli;
 
 namespace {
 
-// The viewer's options and label text, given to the API as any renderer would.
+// The viewer's options and label text, given to the API as `covtrack ar` gives them.
 client::ArView ar_view_of(const RegionsModel& model, const cv::Size& screen) {
-  std::vector<client::ArObject> objects;
-  for (std::size_t i = 0; i < model.objects.size(); ++i) {
-    const scene::SceneObject& o = model.scene.objects[i];
-    std::vector<bool> listed;
-    for (scene::Augmentation a : o.augmentations) listed.push_back(a == scene::Augmentation::label);
-    objects.push_back({o.name, o.frame, model.objects[i].hull_vertices_m, o.level_of_error_px,
-                       o.level_of_error_margin_px, listed});
-  }
-  client::ArViewOptions options;
-  options.regions.projection.method = client::ProjectionMethod::unscented;
-  options.regions.regions.confidence = model.confidence;
-  options.regions.assessment = {client::largest_semi_axis_px(model.confidence), client::max_value()};
-  options.labels.screen = {client::Vec2(0, 0), client::Vec2(screen.width, screen.height)};
-  options.label_box = [names = objects](std::size_t i, const client::ArObjectFrame& f) {
-    return label_box_px(label_text(names[i].name, f.regions));
-  };
-  auto view = client::ArView::create(model.camera, model.scene.camera.frame, std::move(objects), options);
+  auto view = scene_ar_view(model, screen);
   EXPECT_TRUE(view) << view.error().message;
   return std::move(*view);
 }

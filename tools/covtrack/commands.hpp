@@ -14,5 +14,6 @@ void add_emulate_6dof_command(CLI::App& app);
 void add_devices_command(CLI::App& app);
 void add_render_tags_command(CLI::App& app);
 void add_calibrate_fiducial_command(CLI::App& app);
+void add_ar_command(CLI::App& app);
 
 }  // namespace covtrack::cli

@@ -17,6 +17,9 @@ namespace covtrack::cli {
 
 class FrameMismatches {
  public:
+  // `command` prefixes what is told on stderr.
+  explicit FrameMismatches(std::string command = "covtrack view") : command_(std::move(command)) {}
+
   // Feeds the report to the graph (streams the scene does not use are ignored there);
   // a refused one is told on stderr the first time for its stream.
   void update(client::TransformGraph& graph, const client::TrackedTransform& t) {
@@ -25,7 +28,7 @@ class FrameMismatches {
     const auto mismatch = graph.frame_mismatch(t);
     if (!mismatch) return;
     std::lock_guard lock(mutex_);
-    if (reported_parent_.emplace(t.stream.key(), t.parent_frame).second) std::cerr << "covtrack view: " << *mismatch << "\n";
+    if (reported_parent_.emplace(t.stream.key(), t.parent_frame).second) std::cerr << command_ << ": " << *mismatch << "\n";
   }
   // The frame a refused stream reports in; nothing for a stream that fits.
   std::optional<std::string> reported_parent(const StreamId& id) const {
@@ -36,6 +39,7 @@ class FrameMismatches {
   }
 
  private:
+  std::string command_;
   mutable std::mutex mutex_;
   std::map<std::string, std::string> reported_parent_;  // StreamId::key() -> its parent frame
 };

@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
   covtrack::cli::add_delegated_command(app, "calibrate-fiducial",
                                        "Fit a camera's corner noise model from frames of a board of tags",
                                        "covtrack-vision");
+  covtrack::cli::add_delegated_command(app, "ar", "Draw the objects in 3-D over the camera view, with their error regions",
+                                       "covtrack-ar");
   covtrack::cli::add_emulate_lenz_command(app);
   covtrack::cli::add_emulate_6dof_command(app);
   covtrack::cli::add_devices_command(app);

@@ -23,15 +23,12 @@
 
 #include "commands.hpp"
 #include "covtrack/program/command_line.hpp"
-#include "covtrack/client/subscriber.hpp"
-#include "covtrack/protocol/clock.hpp"
-#include "covtrack/protocol/lcm_url.hpp"
 #include "region_drawing.hpp"
 #include "regions_report.hpp"
 #include "stop_signal.hpp"
-#include "subscriber_summary.hpp"
 #include "view_background.hpp"
 #include "view_log.hpp"
+#include "view_source.hpp"
 #include "view_video.hpp"
 #include "view_widgets.hpp"
 
@@ -52,8 +49,6 @@ struct ViewArgs {
   double confidence = 0;
   client::ProjectionMethod method = client::ProjectionMethod::unscented;
 };
-
-using LatestReport = std::function<std::optional<client::TrackedTransform>(const StreamId&)>;
 
 // One line per tracked transform: where its value comes from and how old it is.
 std::vector<std::string> legend_lines(const RegionsModel& model, const LatestReport& latest_report,
@@ -113,42 +108,10 @@ int run_view(const ViewArgs& args) {
   auto widgets = ViewWidgets::create(model->scene);
   if (!widgets) return fail_with(fmt::format("{}: {}", args.scene_path, widgets.error().message), 2);
 
-  if (args.live && !args.log_path.empty()) return fail_with("--live and --log exclude each other", 2);
-  client::TransformGraph graph;
-  std::unique_ptr<client::Subscriber> subscriber;
-  std::optional<LogFollower> log;
-  LatestReport latest_report;  // none: the scene's fixed values
-  FrameMismatches mismatches;
-  const bool fixed = !args.live && args.log_path.empty();
-  const std::optional<std::int64_t> fixed_at =
-      fixed ? std::optional<std::int64_t>(covtrack::now_us()) : std::nullopt;
-  if (auto r = scene::add_scene_transforms(model->scene, graph, fixed_at); !r)
-    return fail_with(fmt::format("{}: {}", args.scene_path, r.error().message), 2);
-  if (args.live) {
-    auto sub = client::Subscriber::open({.lcm_url = args.lcm_url});
-    if (!sub) return fail_with(sub.error().message, program::kExitRuntimeError);
-    subscriber = std::move(*sub);
-    std::cerr << receive_buffer_warning(*subscriber, "covtrack view: ");
-    // Streams the scene does not use are simply not in the graph.
-    (void)subscriber->on_pose(".*", [&](const client::TrackedTransform& t) { mismatches.update(graph, t); });
-    latest_report = [&subscriber](const StreamId& id) { return subscriber->latest(id); };
-  }
-  if (!args.log_path.empty()) {
-    auto opened = LogFollower::open(args.log_path);
-    if (!opened) return fail_with(opened.error().message, 2);
-    log.emplace(std::move(*opened));
-    latest_report = [&log](const StreamId& id) { return log->latest(id); };
-  }
-
-  // What the streams brought, and what was refused, when the view ends.
-  const auto report_rejections = [&] {
-    if (subscriber) {
-      subscriber->stop();
-      std::cerr << subscriber_summary(*subscriber, "covtrack view: ");
-    }
-    if (log && log->rejections().total > 0)
-      std::cerr << "covtrack view: rejected pose messages of the log: " << log->rejections().summary() << "\n";
-  };
+  auto source = ViewSource::open(*model, {args.live, args.lcm_url, args.log_path, args.speed}, "covtrack view");
+  if (!source) return fail_with(source.error().message, source.error().exit_code);
+  ViewSource& src = **source;
+  LogFollower* log = src.log();
 
   const cv::Size size(model->camera.width_px, model->camera.height_px);
   std::string warning;
@@ -163,14 +126,13 @@ int run_view(const ViewArgs& args) {
   if (window) cv::namedWindow("covtrack view", cv::WINDOW_AUTOSIZE);
 
   install_stop_signals();
-  // Scripts and tests wait for this line: from here on every message counts.
-  if (subscriber) std::cerr << "covtrack view: following the streams on " << effective_lcm_url(args.lcm_url) << "\n";
+  src.announce();
   // A video of a log covers all of it; one of a scene or of live streams, 10 s.
   const double duration_s = args.duration_s > 0 ? args.duration_s : (video && !log ? 10.0 : 0.0);
   // Offline into a file (a scene or a log), nothing outside sets the pace: frames are
   // rendered at their scene or log times as fast as they can be, and the same command
   // gives the same pictures.
-  const bool virtual_clock = !args.live && !window;
+  const bool virtual_clock = !src.live() && !window;
   const auto start = std::chrono::steady_clock::now();
   const auto period = std::chrono::duration<double>(1.0 / args.fps);
   for (long frame_index = 0;; ++frame_index) {
@@ -179,19 +141,10 @@ int run_view(const ViewArgs& args) {
       std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(frame_index * period));
       elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
-    // The log's clock runs at --speed from its first event.
-    const std::optional<std::int64_t> log_time =
-        log ? std::optional<std::int64_t>(log->start_us() + std::llround(elapsed_s * args.speed * 1e6))
-            : std::nullopt;
-    if (log) log->advance_to(*log_time, graph, mismatches);
-    const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s - 1e-9) ||
-                      (log && log->finished());
-    // Fixed scene values are as fresh as when they were set: no staleness grows on them.
-    const std::int64_t now = log_time ? *log_time : fixed_at.value_or(covtrack::now_us());
-    if (fixed)
-      if (auto r = scene::report_keyframes(model->scene, graph, elapsed_s, now); !r)
-        return fail_with(fmt::format("{}: {}", args.scene_path, r.error().message), 2);
-    const auto report = compute_regions(*model, graph, now, args.method);
+    const auto now = src.advance(elapsed_s);
+    if (!now) return fail_with(now.error().message, 2);
+    const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s - 1e-9) || src.finished();
+    const auto report = compute_regions(*model, src.graph(), *now, args.method);
     if (!report) return fail_with(fmt::format("{}: {}", args.scene_path, report.error().message), 2);
     // Every frame feeds the Level-of-Error hysteresis, even those --png does not write.
     const WidgetFrame widget_frame = widgets->update(*report, size);
@@ -207,14 +160,14 @@ int run_view(const ViewArgs& args) {
       std::cerr << "covtrack view: " << warning << "\n";
       warning.clear();
     }
-    auto lines = legend_lines(*model, latest_report, mismatches, now);
+    auto lines = legend_lines(*model, src.latest_report(), src.mismatches(), *now);
     if (const std::string line = selection_line(*report, widget_frame); !line.empty()) lines.push_back(line);
     draw_regions(image, *report, &widget_frame, legend_height_px(lines.size(), image.rows));
     draw_legend(image, lines);
 
     if (!args.png_path.empty()) {
       if (auto r = write_png(image, args.png_path); !r) return fail_with(r.error().message, 1);
-      report_rejections();
+      src.report_rejections();
       return 0;
     }
     if (video) video->write(image);
@@ -225,7 +178,7 @@ int run_view(const ViewArgs& args) {
     }
     if (last) break;
   }
-  report_rejections();
+  src.report_rejections();
   return 0;
 }
 

@@ -114,7 +114,10 @@ const TableSpec& object_spec() {
                             {"level_of_error_margin_px", ValueType::Float, "px", "1",
                              "hysteresis: a level is left only this far below its threshold", 0, 1e6},
                             {"augmentations", ValueType::StringArray, "", "[\"outline\"]",
-                             "one per level: outline, region or label (one more than thresholds)"}}};
+                             "one per level: outline, region or label (one more than thresholds)"},
+                            {"model", ValueType::String, "", "(its hull)",
+                             "covtrack ar: a 3-D model of the object (any format OpenSceneGraph reads), in its "
+                             "frame and in metres, relative to the scene file"}}};
   return s;
 }
 
@@ -173,10 +176,11 @@ std::vector<Vec3> box(const Vec3& size, const Vec3& center) {
   return out;
 }
 
-SceneObject read_object(TableReader& r) {
+SceneObject read_object(TableReader& r, const std::string& base_dir) {
   SceneObject o;
   o.name = r.string("name");
   o.frame = r.string("frame");
+  if (r.has("model")) o.model_path = (std::filesystem::path(base_dir) / r.string("model")).string();
   if (r.has("box_m") == r.has("vertices_m")) {
     r.error("box_m", "give exactly one of box_m or vertices_m");
   } else if (r.has("box_m")) {
@@ -256,7 +260,7 @@ Result<Scene> parse_scene(std::string_view text, const std::string& source, cons
   const auto objects = top.tables("object");
   for (std::size_t i = 0; i < objects.size(); ++i) {
     TableReader r(*objects[i], fmt::format("object[{}]", i), object_spec(), source, errors);
-    scene.objects.push_back(read_object(r));
+    scene.objects.push_back(read_object(r, base_dir));
   }
   if (const toml::table* p = top.table("pointer")) {
     TableReader r(*p, "pointer", pointer_spec(), source, errors);

@@ -61,6 +61,7 @@ struct SceneObject {
   std::vector<double> level_of_error_px;
   double level_of_error_margin_px = 1;
   std::vector<Augmentation> augmentations{Augmentation::outline};
+  std::string model_path;  // `covtrack ar`'s 3-D model, resolved against the scene's folder; empty: its hull
 };
 
 enum class Likelihood { area, distance };

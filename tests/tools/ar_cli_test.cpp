@@ -1,0 +1,138 @@
+// `covtrack ar` as a user runs it, drawing with Mesa on a virtual X server (the test runs
+// under xvfb-run): a scene with a shipped 3-D model (config/models/stylus.obj) and an
+// object drawn as its hull, through a distortion-free camera. Every pixel of the drawn
+// objects lies inside the union of the outer regions `covtrack regions --json` gives for
+// the same scene, and each object fills its inner region. Mistakes are reported: a model
+// that is missing or unreadable, no display.
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "cli_support.hpp"
+
+using namespace covtrack::testing;
+
+namespace {
+
+class ArCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("covtrack_ar_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  // A scene of a stylus (the shipped model) and a crate (its hull), seen by the pinhole
+  // camera of the fiducial emulator; `model` replaces the stylus's model path.
+  std::string write_scene(const std::string& model = COVTRACK_SOURCE_DIR "/config/models/stylus.obj") {
+    const std::string path = (dir_ / "scene.toml").string();
+    std::ofstream(path) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR
+                           "/config/cameras/rendered_640x480.yml\"\nconfidence = 0.95\n"
+                           "[[transform]]\nparent = \"world\"\nchild = \"camera\"\n"
+                           "sigma_m = [0.001, 0.001, 0.001]\nsigma_rad = [0.002, 0.002, 0.002]\n"
+                           "[[transform]]\nparent = \"world\"\nchild = \"tool\"\nposition_m = [0.03, 0.02, 0.3]\n"
+                           "rotation_rpy_deg = [70, 0, 30]\nsigma_m = [0.0015, 0.0015, 0.0015]\n"
+                           "sigma_rad = [0.0087, 0.0087, 0.0087]\n"
+                           "[[transform]]\nparent = \"world\"\nchild = \"crate\"\nposition_m = [-0.1, 0.05, 0.5]\n"
+                           "rotation_rpy_deg = [20, 30, 10]\nsigma_m = [0.002, 0.002, 0.002]\n"
+                           "sigma_rad = [0.005, 0.005, 0.005]\n"
+                           "[[object]]\nname = \"stylus\"\nframe = \"tool\"\n"
+                           "vertices_m = [0.0, 0.0, 0.0, 0.008, 0.0, 0.03, -0.008, 0.0, 0.03, 0.0, 0.008, 0.03, "
+                           "0.0, -0.008, 0.03, 0.008, 0.0, 0.15, -0.008, 0.0, 0.15, 0.0, 0.008, 0.15, "
+                           "0.0, -0.008, 0.15]\nmodel = \""
+                        << model
+                        << "\"\n[[object]]\nname = \"crate\"\nframe = \"crate\"\nbox_m = [0.08, 0.06, 0.04]\n";
+    return path;
+  }
+
+  std::filesystem::path dir_;
+};
+
+// Shaded surfaces: the objects are coloured, labels and the black background are not.
+bool coloured(const cv::Vec3b& p) {
+  const int hi = std::max({p[0], p[1], p[2]}), lo = std::min({p[0], p[1], p[2]});
+  return hi - lo > 40 && hi > 60;
+}
+
+}  // namespace
+
+TEST_F(ArCli, DrawnObjectsLieInsideTheirOuterRegionsAndFillTheirInnerOnes) {
+  const std::string scene = write_scene();
+  const std::string png = (dir_ / "ar.png").string();
+  const CliRun r = run_covtrack("ar " + scene + " --no-regions --background '#000000' --png " + png);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const cv::Mat image = cv::imread(png);
+  ASSERT_FALSE(image.empty());
+  ASSERT_EQ(image.cols, 640);
+  ASSERT_EQ(image.rows, 480);
+
+  const CliRun regions = run_covtrack("regions " + scene + " --json");
+  ASSERT_EQ(regions.exit_code, 0) << regions.out;
+  const nlohmann::json doc = nlohmann::json::parse(regions.out, nullptr, false);
+  ASSERT_FALSE(doc.is_discarded()) << regions.out;
+  ASSERT_EQ(doc["objects"].size(), 2u);
+
+  int drawn = 0, outside = 0;
+  for (int v = 0; v < image.rows; ++v)
+    for (int u = 0; u < image.cols; ++u) {
+      if (!coloured(image.at<cv::Vec3b>(v, u))) continue;
+      ++drawn;
+      bool inside = false;
+      for (const auto& o : doc["objects"]) inside = inside || json_polygon_contains(o["outer_px"], u, v, 1.0);
+      outside += !inside;
+    }
+  EXPECT_GT(drawn, 2000) << "both objects must be drawn";
+  EXPECT_EQ(outside, 0) << "of " << drawn << " object pixels";
+
+  for (const auto& o : doc["objects"]) {
+    int inner = 0, filled = 0;
+    for (int v = 0; v < image.rows; ++v)
+      for (int u = 0; u < image.cols; ++u)
+        if (json_polygon_contains(o["inner_px"], u, v, -2.0)) ++inner, filled += coloured(image.at<cv::Vec3b>(v, u));
+    EXPECT_GT(inner, 100) << o["name"];
+    // The label's white text covers some of it.
+    EXPECT_GT(filled, inner * 7 / 10) << o["name"];
+  }
+}
+
+TEST_F(ArCli, ShippedScenesDrawAndRegionsAreDrawnByDefault) {
+  for (const char* name : {"toolbox.toml", "fixed_camera_tracked_tool.toml"}) {
+    const std::string png = (dir_ / (std::string(name) + ".png")).string();
+    const CliRun r = run_covtrack(std::string("ar " COVTRACK_SOURCE_DIR "/config/scenes/") + name + " --png " + png);
+    ASSERT_EQ(r.exit_code, 0) << name << ": " << r.out;
+    const cv::Mat image = cv::imread(png);
+    ASSERT_FALSE(image.empty()) << name;
+    // The outer regions' outline colour (BGR 0, 204, 255).
+    int outline = 0;
+    for (int v = 0; v < image.rows; ++v)
+      for (int u = 0; u < image.cols; ++u) {
+        const cv::Vec3b p = image.at<cv::Vec3b>(v, u);
+        outline += p[2] > 200 && p[1] > 150 && p[1] < 250 && p[0] < 60;
+      }
+    EXPECT_GT(outline, 200) << name;
+  }
+}
+
+TEST_F(ArCli, MistakesAreReported) {
+  CliRun r = run_covtrack("ar " + write_scene((dir_ / "nothing.obj").string()) + " --png " + (dir_ / "a.png").string());
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("nothing.obj: no such file"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("'stylus'"), std::string::npos) << r.out;
+
+  const std::string unreadable = (dir_ / "broken.obj").string();
+  std::ofstream(unreadable) << "this is not a model\n";
+  r = run_covtrack("ar " + write_scene(unreadable) + " --png " + (dir_ / "b.png").string());
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("cannot read it"), std::string::npos) << r.out;
+
+  r = run_covtrack("ar " + write_scene() + " --png " + (dir_ / "c.png").string(), "env -u DISPLAY");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.out.find("xvfb-run"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "c.png"));
+}
