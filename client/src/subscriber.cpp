@@ -8,6 +8,7 @@
 #include <mutex>
 #include <regex>
 #include <thread>
+#include <unordered_map>
 
 #include "covtrack/client/pose_validation.hpp"
 #include "covtrack/client/sequence_tracker.hpp"
@@ -15,6 +16,7 @@
 #include "covtrack/protocol/channel_pattern.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
+#include "udpm_receiver.hpp"
 
 namespace covtrack::client {
 namespace {
@@ -24,6 +26,10 @@ constexpr int kStaleCheckMs = 20;
 constexpr std::int64_t kDrainUs = 200'000;
 // Heartbeats come once per second per device; this only absorbs a burst at start-up.
 constexpr int kStatusQueueCapacity = 1000;
+// Batches of datagrams read per wake-up before the clock is checked for silence.
+constexpr int kBatchesPerWake = 16;
+// Channels whose verdict is remembered; the bus has few, a flood of made-up ones resets it.
+constexpr std::size_t kChannelVerdicts = 4096;
 
 struct Callback {
   std::regex pattern;
@@ -32,12 +38,23 @@ struct Callback {
 // Replaced, never modified, so the dispatch thread can call a snapshot without a lock.
 using CallbackList = std::vector<Callback>;
 
+// Lets an unordered_map<std::string, ...> be searched with a string_view (no allocation).
+struct TextHash {
+  using is_transparent = void;
+  std::size_t operator()(std::string_view s) const { return std::hash<std::string_view>{}(s); }
+};
+
 }  // namespace
 
-struct Subscriber::Impl {
+// Receives through one of two paths: for udpm:// URLs its own UdpmReceiver, read on the
+// dispatch thread; otherwise (memq://, an attached instance) an lcm::LCM instance.
+struct Subscriber::Impl final : UdpmReceiver::Handler {
   SubscriberOptions options;
-  std::shared_ptr<lcm::LCM> lcm;
+  std::shared_ptr<lcm::LCM> lcm;  // the LCM path
   std::vector<lcm::Subscription*> subscriptions;
+  std::unique_ptr<UdpmReceiver> udpm;  // the udpm path
+  std::regex stream_pattern;           // options.pattern, over "device/sensor"
+  std::unordered_map<std::string, bool, TextHash, std::equal_to<>> channel_verdicts;  // udpm: wants()
   int wake_fd = -1;
   std::jthread thread;
 
@@ -63,6 +80,12 @@ struct Subscriber::Impl {
     if (wake_fd >= 0) ::close(wake_fd);
   }
 
+  // A shared instance outlives us: it must not call back into a destroyed Impl.
+  void unsubscribe() {
+    for (auto* s : subscriptions) lcm->unsubscribe(s);
+    subscriptions.clear();
+  }
+
   std::shared_ptr<const CallbackList> callback_snapshot() {
     std::lock_guard lock(callbacks_mutex);
     return callbacks;
@@ -75,10 +98,40 @@ struct Subscriber::Impl {
   }
 
   void on_pose_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    on_pose(channel, bytes_of(rbuf->data, rbuf->data_size));
+  }
+  void on_status_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    on_status(channel, bytes_of(rbuf->data, rbuf->data_size));
+  }
+
+  // UdpmReceiver::Handler: the channels LCM's subscriptions would let in (below, attach()).
+  bool wants(std::string_view channel) override {
+    if (auto it = channel_verdicts.find(channel); it != channel_verdicts.end()) return it->second;
+    bool wanted = channel.starts_with(kStatusPrefix);
+    if (channel.starts_with(kPosePrefix)) {
+      const auto stream = channel.substr(kPosePrefix.size());
+      wanted = std::regex_match(stream.begin(), stream.end(), stream_pattern);
+    }
+    if (channel_verdicts.size() >= kChannelVerdicts) channel_verdicts.clear();
+    channel_verdicts.emplace(channel, wanted);
+    return wanted;
+  }
+  void on_message(std::string_view channel, std::span<const std::byte> payload) override {
+    if (channel.starts_with(kPosePrefix))
+      on_pose(channel, payload);
+    else
+      on_status(channel, payload);
+  }
+  void on_malformed(const std::string& from, const lcm_wire::DatagramRejection& why) override {
+    std::lock_guard lock(mutex);
+    rejections.add(lcm_wire::to_string(why.fault), "datagram from " + from, why.describe());
+  }
+
+  void on_pose(std::string_view channel, std::span<const std::byte> bytes) {
     const std::int64_t now = now_us();
-    const auto decoded = decode_pose(channel, bytes_of(rbuf->data, rbuf->data_size));
+    const auto decoded = decode_pose(channel, bytes);
     const auto id = parse_pose_channel(channel);
-    if (!id) return reject_unowned(channel, decoded.error());
+    if (!id) return reject_unowned(std::string(channel), decoded.error());
     std::optional<std::pair<std::string, std::string>> rejection;  // reason, description
     if (!decoded)
       rejection.emplace(to_string(decoded.error().fault), decoded.error().describe());
@@ -104,7 +157,7 @@ struct Subscriber::Impl {
       if (rejection) {
         ++s.state.counters.rejected;
         s.state.last_rejection = rejection->second;
-        rejections.add(rejection->first, channel, rejection->second);
+        rejections.add(rejection->first, std::string(channel), rejection->second);
         return;
       }
       if (order == SequenceTracker::Verdict::Foreign) {
@@ -135,10 +188,10 @@ struct Subscriber::Impl {
     return s.matched;
   }
 
-  void on_status_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  void on_status(std::string_view channel, std::span<const std::byte> bytes) {
     const std::int64_t now = now_us();
-    const auto decoded = decode_status(channel, bytes_of(rbuf->data, rbuf->data_size));
-    if (!decoded) return reject_unowned(channel, decoded.error());
+    const auto decoded = decode_status(channel, bytes);
+    if (!decoded) return reject_unowned(std::string(channel), decoded.error());
     std::lock_guard lock(mutex);
     devices[decoded->device].on_heartbeat(*decoded, now);
   }
@@ -180,24 +233,31 @@ struct Subscriber::Impl {
     return last;
   }
 
-  // LCM's handle() cannot be interrupted: poll its descriptor together with wake_fd,
-  // which stop() writes to.
+  // Reads what has arrived: LCM's queue, or the udpm socket in batches.
+  // Returns whether there was anything.
+  bool receive() {
+    if (udpm) return udpm->read_available(*this, kBatchesPerWake) > 0;
+    return lcm->handleTimeout(0) > 0;
+  }
+
+  // Neither LCM's handle() nor a wait on the socket can be interrupted: poll the
+  // descriptor together with wake_fd, which stop() writes to.
   void dispatch(std::stop_token stop) {
-    pollfd fds[2] = {{lcm->getFileno(), POLLIN, 0}, {wake_fd, POLLIN, 0}};
+    pollfd fds[2] = {{udpm ? udpm->fd() : lcm->getFileno(), POLLIN, 0}, {wake_fd, POLLIN, 0}};
     std::int64_t next_stale_check = 0;
     while (!stop.stop_requested()) {
       const int n = ::poll(fds, 2, kStaleCheckMs);
-      if (n > 0 && (fds[0].revents & POLLIN)) lcm->handle();
+      if (n > 0 && (fds[0].revents & POLLIN)) receive();
       // At high rates poll() never times out: check staleness on a clock, not per wake-up.
       if (const std::int64_t now = now_us(); now >= next_stale_check) {
         check_silence();
         next_stale_check = now + kStaleCheckMs * 1000;
       }
     }
-    // What LCM had already received when told to stop still counts (a program's summary
-    // at exit covers everything sent before it was stopped); bounded, as a stream never ends.
+    // What had already arrived when told to stop still counts (a program's summary at
+    // exit covers everything sent before it was stopped); bounded, as a stream never ends.
     const std::int64_t drain_end = now_us() + kDrainUs;
-    while (now_us() < drain_end && lcm->handleTimeout(0) > 0) {
+    while (now_us() < drain_end && receive()) {
     }
   }
 };
@@ -207,8 +267,20 @@ Subscriber::Subscriber(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Subscriber::~Subscriber() { stop(); }
 
 Result<std::unique_ptr<Subscriber>> Subscriber::open(const SubscriberOptions& options) {
-  if (auto re = compile_channel_pattern(options.pattern); !re) return std::unexpected(re.error());
-  auto lcm = open_lcm(options.lcm_url);
+  auto re = compile_channel_pattern(options.pattern);
+  if (!re) return std::unexpected(re.error());
+  const std::string url = effective_lcm_url(options.lcm_url);
+  if (url.starts_with("udpm://")) {
+    if (auto ok = check_lcm_url(url); !ok) return std::unexpected(ok.error());
+    auto receiver = UdpmReceiver::open(url);
+    if (!receiver) return std::unexpected(receiver.error());
+    auto impl = std::make_unique<Impl>();
+    impl->options = options;
+    impl->stream_pattern = std::move(*re);
+    impl->udpm = std::move(*receiver);
+    return start(std::move(impl));
+  }
+  auto lcm = open_lcm(url);
   if (!lcm) return std::unexpected(lcm.error());
   return attach(std::shared_ptr<lcm::LCM>(std::move(*lcm)), options);
 }
@@ -220,17 +292,23 @@ Result<std::unique_ptr<Subscriber>> Subscriber::attach(std::shared_ptr<lcm::LCM>
   auto impl = std::make_unique<Impl>();
   impl->options = options;
   impl->lcm = std::move(lcm);
-  impl->wake_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
-  if (impl->wake_fd < 0) return fail("Subscriber: eventfd failed");
-
-  Impl* raw = impl.get();
   // LCM anchors a subscription's regex at both ends: "whole match" comes for free.
-  auto* poses = raw->lcm->subscribe(std::string(kPosePrefix) + "(" + options.pattern + ")",
-                                    &Impl::on_pose_bytes, raw);
+  auto* poses = impl->lcm->subscribe(std::string(kPosePrefix) + "(" + options.pattern + ")",
+                                     &Impl::on_pose_bytes, impl.get());
   poses->setQueueCapacity(options.queue_capacity);
-  auto* status = raw->lcm->subscribe(std::string(kStatusPrefix) + ".*", &Impl::on_status_bytes, raw);
+  auto* status = impl->lcm->subscribe(std::string(kStatusPrefix) + ".*", &Impl::on_status_bytes, impl.get());
   status->setQueueCapacity(kStatusQueueCapacity);
-  raw->subscriptions = {poses, status};
+  impl->subscriptions = {poses, status};
+  return start(std::move(impl));
+}
+
+Result<std::unique_ptr<Subscriber>> Subscriber::start(std::unique_ptr<Impl> impl) {
+  impl->wake_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+  if (impl->wake_fd < 0) {
+    impl->unsubscribe();
+    return fail("Subscriber: eventfd failed");
+  }
+  Impl* raw = impl.get();
   raw->thread = std::jthread([raw](std::stop_token stop) { raw->dispatch(stop); });
   return std::unique_ptr<Subscriber>(new Subscriber(std::move(impl)));
 }
@@ -292,9 +370,12 @@ void Subscriber::stop() {
   const std::uint64_t one = 1;
   [[maybe_unused]] auto n = ::write(impl_->wake_fd, &one, sizeof one);
   impl_->thread.join();
-  // A shared instance outlives us: it must not call back into a destroyed Impl.
-  for (auto* s : impl_->subscriptions) impl_->lcm->unsubscribe(s);
-  impl_->subscriptions.clear();
+  impl_->unsubscribe();
+}
+
+std::optional<ReceiveBufferSize> Subscriber::receive_buffer() const {
+  if (!impl_->udpm) return std::nullopt;
+  return impl_->udpm->receive_buffer();
 }
 
 }  // namespace covtrack::client

@@ -5,7 +5,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <climits>
 #include <cstdlib>
 #include <cstring>
 
@@ -19,12 +21,43 @@ std::string fix_hint() {
          "or pass another URL with --lcm-url (for example memq:// inside one process).";
 }
 
+// The value of option `key` as an integer in [low, high].
+Result<int> option_value(const std::string& url, const std::string& key, const std::string& text, long low,
+                         long high) {
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(text.c_str(), &end, 0);  // base 0, as LCM reads it
+  if (text.empty() || *end != '\0' || errno != 0 || v < low || v > high)
+    return fail("LCM URL '" + url + "': " + key + "='" + text + "' is not an integer in " + std::to_string(low) +
+                "-" + std::to_string(high));
+  return static_cast<int>(v);
+}
+
+Result<void> parse_option(const std::string& url, const std::string& option, UdpmUrl& out) {
+  const auto eq = option.find('=');
+  const std::string key = option.substr(0, eq);
+  const std::string value = eq == std::string::npos ? "" : option.substr(eq + 1);
+  if (key == "transmit_only") return {};  // obsolete in LCM, which ignores it
+  if (key == "ttl") {
+    auto v = option_value(url, key, value, 0, 255);
+    if (!v) return std::unexpected(v.error());
+    out.ttl = *v;
+  } else if (key == "recv_buf_size") {
+    auto v = option_value(url, key, value, 1, INT_MAX);
+    if (!v) return std::unexpected(v.error());
+    out.recv_buf_size = *v;
+  } else {
+    return fail("LCM URL '" + url + "': unknown option '" + key + "' (udpm takes ttl and recv_buf_size)");
+  }
+  return {};
+}
 }  // namespace
 
-// udpm://GROUP:PORT?options -> the group and port; LCM's defaults where missing.
-Result<sockaddr_in> parse_udpm(const std::string& url) {
+Result<UdpmUrl> parse_udpm_url(const std::string& url) {
   std::string rest = url.substr(std::strlen("udpm://"));
-  rest = rest.substr(0, rest.find('?'));
+  const auto question = rest.find('?');
+  const std::string options = question == std::string::npos ? "" : rest.substr(question + 1);
+  rest = rest.substr(0, question);
   std::string host = "239.255.76.67";
   int port = 7667;
   if (!rest.empty()) {
@@ -38,14 +71,26 @@ Result<sockaddr_in> parse_udpm(const std::string& url) {
       port = static_cast<int>(p);
     }
   }
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<uint16_t>(port));
-  if (inet_pton(AF_INET, host.c_str(), &addr.sin_addr) != 1)
+  UdpmUrl out;
+  out.group.sin_family = AF_INET;
+  out.group.sin_port = htons(static_cast<uint16_t>(port));
+  if (inet_pton(AF_INET, host.c_str(), &out.group.sin_addr) != 1)
     return fail("LCM URL '" + url + "': '" + host + "' is not an IPv4 address");
-  if (!IN_MULTICAST(ntohl(addr.sin_addr.s_addr)))
+  if (!IN_MULTICAST(ntohl(out.group.sin_addr.s_addr)))
     return fail("LCM URL '" + url + "': " + host + " is not a multicast group (224.0.0.0/4)");
-  return addr;
+  for (std::size_t at = 0; at < options.size();) {
+    const auto amp = std::min(options.find('&', at), options.size());
+    if (amp > at)
+      if (auto ok = parse_option(url, options.substr(at, amp - at), out); !ok) return std::unexpected(ok.error());
+    at = amp + 1;
+  }
+  return out;
+}
+
+Result<sockaddr_in> parse_udpm(const std::string& url) {
+  auto parsed = parse_udpm_url(url);
+  if (!parsed) return std::unexpected(parsed.error());
+  return parsed->group;
 }
 
 std::string effective_lcm_url(const std::string& url) {

@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "covtrack/protocol/lcm_datagram.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 
 namespace covtrack::server {
@@ -82,15 +83,13 @@ ClaimListener::~ClaimListener() {
 std::optional<ClaimListener::Message> ClaimListener::receive(int timeout_ms) {
   pollfd p{fd_, POLLIN, 0};
   if (::poll(&p, 1, timeout_ms) <= 0) return std::nullopt;
-  std::byte datagram[65536];
+  std::byte datagram[lcm_wire::kMaxDatagramBytes + 1];
   const ssize_t n = ::recv(fd_, datagram, sizeof datagram, MSG_DONTWAIT);
-  if (n < 8) return std::nullopt;
-  const auto* begin = reinterpret_cast<const char*>(datagram) + 8;
-  const auto* end = reinterpret_cast<const char*>(datagram) + n;
-  const auto* nul = static_cast<const char*>(std::memchr(begin, '\0', static_cast<std::size_t>(end - begin)));
-  if (!nul) return std::nullopt;
-  return Message{std::string(begin, nul), std::vector<std::byte>(reinterpret_cast<const std::byte*>(nul + 1),
-                                                                 reinterpret_cast<const std::byte*>(end))};
+  if (n <= 0) return std::nullopt;
+  const auto decoded = lcm_wire::decode_datagram({datagram, static_cast<std::size_t>(n)});
+  const auto* m = decoded ? std::get_if<lcm_wire::ShortMessage>(&*decoded) : nullptr;
+  if (!m) return std::nullopt;  // the filter lets only short messages through
+  return Message{std::string(m->channel), std::vector<std::byte>(m->payload.begin(), m->payload.end())};
 }
 
 }  // namespace covtrack::server

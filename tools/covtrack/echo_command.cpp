@@ -160,6 +160,7 @@ int run_echo(const EchoOptions& o) {
   // Scripts and tests wait for this line: from here on every message is seen.
   std::cerr << fmt::format("covtrack echo: listening on {} for streams '{}' (Ctrl-C ends)\n",
                            effective_lcm_url(o.subscriber.lcm_url), o.subscriber.pattern);
+  std::cerr << receive_buffer_warning(**sub, "covtrack echo: ");
   std::atomic<long> seen{0};
   // Runs on the subscriber's dispatch thread, the only writer of stdout in --json mode.
   (void)(*sub)->on_pose(".*", [&](const client::TrackedTransform& t) {

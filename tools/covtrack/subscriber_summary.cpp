@@ -14,4 +14,10 @@ std::string subscriber_summary(const client::Subscriber& subscriber, const std::
   return out;
 }
 
+std::string receive_buffer_warning(const client::Subscriber& subscriber, const std::string& prefix) {
+  const auto buffer = subscriber.receive_buffer();
+  if (!buffer || buffer->note.empty()) return "";
+  return fmt::format("{}warning: {}\n", prefix, buffer->note);
+}
+
 }  // namespace covtrack::cli

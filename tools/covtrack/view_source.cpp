@@ -35,6 +35,7 @@ std::expected<std::unique_ptr<ViewSource>, ViewSourceError> ViewSource::open(con
     auto sub = client::Subscriber::open({.lcm_url = args.lcm_url});
     if (!sub) return error(sub.error().message, program::kExitRuntimeError);
     s->subscriber_ = std::move(*sub);
+    std::cerr << receive_buffer_warning(*s->subscriber_, s->command_ + ": ");
     // Streams the scene does not use are simply not in the graph.
     ViewSource* self = s.get();
     (void)self->subscriber_->on_pose(".*", [self](const client::TrackedTransform& t) {

@@ -1,10 +1,16 @@
 #pragma once
-// Receives covtrack pose streams and device heartbeats on one LCM dispatch thread.
+// Receives covtrack pose streams and device heartbeats on one dispatch thread.
 //
 //   auto sub = covtrack::client::Subscriber::open({.lcm_url = url, .pattern = "sim/.*"});
 //   if (!sub) { report(sub.error().message); return; }
 //   (*sub)->on_pose(".*", [](const TrackedTransform& t) { ... });   // dispatch thread
 //   auto head = (*sub)->latest({"sim", "head"});                        // any thread
+//
+// Transport: for a udpm:// URL (LCM's default) the dispatch thread reads the multicast
+// socket itself, in batches, speaking LCM's wire format (any LCM publisher reaches it,
+// fragmented messages included); there is no LCM receive thread and no queue between the
+// two. Its socket receive buffer defaults to 4 MiB (receive_buffer()). Other URLs
+// (memq://, ...) and attach() go through an lcm::LCM instance.
 //
 // Thread safety: every const method, on_pose() and stop() may be called from any thread.
 // Callbacks run on the dispatch thread, one at a time, in arrival order; they must return
@@ -36,6 +42,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "covtrack/client/device_tracker.hpp"
+#include "covtrack/client/receive_buffer.hpp"
 #include "covtrack/client/tracked_transform.hpp"
 #include "covtrack/protocol/rejection_tally.hpp"
 #include "covtrack/protocol/result.hpp"
@@ -46,8 +53,10 @@ struct SubscriberOptions {
   std::string lcm_url = {};      // empty: $LCM_DEFAULT_URL, else LCM's default
   std::string pattern = ".*";    // over "device/sensor" (protocol/channel_pattern.hpp)
   double stale_after_s = 0.5;    // a stream is stale after this long without a message
-  // LCM drops the newest message silently when a subscription's queue is full (default
-  // 30); this is that queue's length, large enough for a burst of several seconds.
+  // Through lcm::LCM (not udpm://): LCM drops the newest message silently when a
+  // subscription's queue is full (default 30); this is that queue's length, large enough
+  // for a burst of several seconds. On udpm:// the socket's receive buffer is the queue:
+  // its size is the URL's recv_buf_size.
   int queue_capacity = 100000;
   // The largest forward jump of a stream's sequence still counted as loss; beyond it, or
   // backwards, a message is off the stream's track (SequenceTracker).
@@ -104,10 +113,15 @@ class Subscriber {
   std::map<std::string, device_status_t> device_statuses() const;
   // Each device as its heartbeats tell it (reachable, publishers, restarts), by name.
   std::map<std::string, DeviceState> devices() const;
-  // Every message rejected so far (poses, heartbeats, channels that name no stream).
+  // Every message rejected so far (poses, heartbeats, channels that name no stream, and
+  // on udpm:// datagrams that are not LCM's format).
   RejectionTally rejections() const;
 
-  // Ends the dispatch thread, after it has handled what LCM had already received (for at
+  // On udpm://, the socket receive buffer asked for and granted, with a note when
+  // net.core.rmem_max capped it (a program should show the note); nothing otherwise.
+  std::optional<ReceiveBufferSize> receive_buffer() const;
+
+  // Ends the dispatch thread, after it has handled what had already arrived (for at
   // most 0.2 s); idempotent, prompt when no message arrives. After it no callback runs;
   // latest() and the counters keep their last values.
   void stop();
@@ -115,6 +129,7 @@ class Subscriber {
  private:
   struct Impl;
   explicit Subscriber(std::unique_ptr<Impl> impl);
+  static Result<std::unique_ptr<Subscriber>> start(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
 

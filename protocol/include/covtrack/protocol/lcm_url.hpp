@@ -4,6 +4,7 @@
 #include <netinet/in.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <lcm/lcm-cpp.hpp>
@@ -19,7 +20,17 @@ std::string effective_lcm_url(const std::string& url);
 // Checks that the URL can work on this machine (for udpm: a route to the group).
 Result<void> check_lcm_url(const std::string& url);
 
-// The group and port of a udpm:// URL (LCM's defaults where it names none).
+// A udpm:// URL: udpm://GROUP:PORT?ttl=N&recv_buf_size=BYTES, LCM's defaults where it
+// names none. An option LCM does not know, or a value it could not use, is an error
+// (LCM itself only warns and goes on).
+struct UdpmUrl {
+  sockaddr_in group{};                     // multicast group and port
+  int ttl = 0;                             // 0-255: how many routers a sent datagram may cross
+  std::optional<int> recv_buf_size;        // the socket receive buffer asked for, in bytes
+};
+Result<UdpmUrl> parse_udpm_url(const std::string& url);
+
+// The group and port of a udpm:// URL.
 Result<sockaddr_in> parse_udpm(const std::string& url);
 
 // check_lcm_url, then create the instance.
