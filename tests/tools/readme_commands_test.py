@@ -6,7 +6,7 @@ daemon, `echo`, a live view: it keeps running as a service for the rest of its b
 so that the commands after it see its streams). It fails when it exits with another
 code. The commands run in a scratch folder that links the checkout's folders and the
 build (the README's `build/`), inside the private network namespace and a virtual X
-display this test is started in (CMake: netns_run.sh, xvfb-run).
+display this test is started in (CMake: netns_run.sh, with_xvfb.sh).
 Skipped: tools/test.sh (this suite) and tools/demo.sh (setup and build, then the same
 daemon and echo as the next block). The ```shell blocks (install into $HOME, a Debian
 package with sudo) are not run here: sdk_install_test and deb_package_test run the same
