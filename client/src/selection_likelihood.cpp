@@ -64,4 +64,10 @@ std::vector<double> likelihoods_by_distance(const Pointer& pointer,
   return out;
 }
 
+Selectable selectable_of(const ObjectRegions& regions) {
+  Selectable s{regions.outer, 0};
+  for (const ProjectedVertex& v : regions.vertices) s.depth_m += v.depth_m / static_cast<double>(regions.vertices.size());
+  return s;
+}
+
 }  // namespace covtrack::client

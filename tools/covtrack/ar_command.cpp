@@ -27,6 +27,7 @@
 #include "view_background.hpp"
 #include "view_clock.hpp"
 #include "view_labels.hpp"
+#include "view_options.hpp"
 #include "view_source.hpp"
 #include "view_video.hpp"
 
@@ -36,12 +37,7 @@ namespace {
 struct ArArgs {
   std::string scene_path;
   ViewSourceArgs source;
-  std::string png_path;
-  std::string video_path;
-  std::string background;
-  double duration_s = 0;  // as for `covtrack view`
-  double fps = 30;
-  double confidence = 0;
+  ViewOutputArgs output;
   bool regions = true;
   client::SelectionTechnique technique = client::SelectionTechnique::two_step;
   std::vector<std::string> clicks;
@@ -52,10 +48,10 @@ int run_ar(const ArArgs& args) {
     std::cerr << "covtrack ar: " << message << "\n";
     return code;
   };
-  const bool window = args.png_path.empty() && args.video_path.empty();
-  const auto video_format = args.video_path.empty() ? Result<VideoFormat>{} : video_format_for(args.video_path);
+  const bool window = args.output.png_path.empty() && args.output.video_path.empty();
+  const auto video_format = args.output.video_path.empty() ? Result<VideoFormat>{} : video_format_for(args.output.video_path);
   if (!video_format) return fail_with(video_format.error().message, program::kExitUsageError);
-  const auto model = load_regions_model(args.scene_path, args.confidence);
+  const auto model = load_regions_model(args.scene_path, args.output.confidence);
   if (!model) return fail_with(model.error().message, 2);
   const cv::Size size(model->camera.width_px, model->camera.height_px);
   auto view = scene_ar_view(*model, size);
@@ -84,11 +80,11 @@ int run_ar(const ArArgs& args) {
   if (!source) return fail_with(source.error().message, source.error().exit_code);
   ViewSource& src = **source;
   std::string warning;
-  ViewBackground background(args.background, size, warning);
+  ViewBackground background(args.output.background, size, warning);
   if (background.camera_unavailable()) return fail_with(warning, program::kExitRuntimeError);
   std::optional<cv::VideoWriter> video;
-  if (!args.video_path.empty()) {
-    auto opened = open_video(args.video_path, *video_format, args.fps, size);
+  if (!args.output.video_path.empty()) {
+    auto opened = open_video(args.output.video_path, *video_format, args.output.fps, size);
     if (!opened) return fail_with(opened.error().message, program::kExitRuntimeError);
     video.emplace(std::move(*opened));
   }
@@ -96,8 +92,8 @@ int run_ar(const ArArgs& args) {
   install_stop_signals();
   src.announce();
   // As `covtrack view`: a video of a log covers all of it, else 10 s.
-  const double duration_s = args.duration_s > 0 ? args.duration_s : (video && !src.log() ? 10.0 : 0.0);
-  const ViewClock clock(args.fps, !src.live() && !window);
+  const double duration_s = args.output.duration_s > 0 ? args.output.duration_s : (video && !src.log() ? 10.0 : 0.0);
+  const ViewClock clock(args.output.fps, !src.live() && !window);
   std::vector<std::string> texts(model->scene.objects.size());
   for (long frame_index = 0;; ++frame_index) {
     const double elapsed_s = clock.frame_time_s(frame_index);
@@ -108,11 +104,11 @@ int run_ar(const ArArgs& args) {
     // Every frame takes the clicks due, even those --png does not draw.
     const ar::SelectionDrawing selected = selection->frame(view->frame(), src.graph(), *now, elapsed_s, std::cout);
     // --png takes its one frame at the end of --duration.
-    if (!args.png_path.empty() && !last && duration_s > 0) continue;
+    if (!args.output.png_path.empty() && !last && duration_s > 0) continue;
 
     const client::ArFrame& frame = view->frame();
     for (std::size_t i = 0; i < texts.size(); ++i) texts[i] = label_text(model->scene.objects[i].name, frame.objects[i].regions);
-    cv::Mat image = src.picture(background, args.background.empty(), size, warning);
+    cv::Mat image = src.picture(background, args.output.background.empty(), size, warning);
     if (!warning.empty()) {
       std::cerr << "covtrack ar: " << warning << "\n";
       warning.clear();
@@ -120,8 +116,8 @@ int run_ar(const ArArgs& args) {
     scene.set_video(image);
     scene.update(frame, texts, &selected);
     const bool open = (*viewer)->frame();
-    if (!args.png_path.empty()) {
-      if (auto r = write_png((*viewer)->image(), args.png_path); !r) return fail_with(r.error().message, 1);
+    if (!args.output.png_path.empty()) {
+      if (auto r = write_png((*viewer)->image(), args.output.png_path); !r) return fail_with(r.error().message, 1);
       src.report_rejections();
       return 0;
     }
@@ -136,22 +132,12 @@ int run_ar(const ArArgs& args) {
 
 void add_ar_command(CLI::App& app) {
   auto args = std::make_shared<ArArgs>();
-  auto* cmd = app.add_subcommand("ar", "Draw the objects in 3-D over the camera view, with their error regions");
+  auto* cmd = app.add_subcommand("ar", "Draw the objects in 3-D over the camera view, with their error regions (in a window; "
+                                             "off screen with --png or --video)");
   cmd->add_option("SCENE", args->scene_path, "Scene file (config/scene_schema.md); an object's `model` is its 3-D model")
       ->required();
   add_view_source_options(*cmd, args->source);
-  cmd->add_option("--png", args->png_path, "Draw off screen, write one frame (at the end of --duration, if given) and exit");
-  cmd->add_option("--video", args->video_path, "Draw off screen into this video file: FILE.mp4 (H.264) or FILE.webm (VP9)");
-  cmd->add_option("--background", args->background,
-                  "#rrggbb, an image file, a video file (looped) or camera:N (default with --log: the log's camera "
-                  "frames, if it has any)");
-  cmd->add_option("--duration,-d", args->duration_s,
-                  "Seconds to run (default: until the window closes; for --video the whole --log, else 10); offline "
-                  "(no --live) into a file, scene or log seconds drawn without waiting")
-      ->check(program::non_negative());
-  cmd->add_option("--fps", args->fps, "Frames per second")->capture_default_str()->check(program::in_range(0.1, 240.0));
-  cmd->add_option("--confidence", args->confidence, "Confidence of the regions (default: the scene's)")
-      ->check(program::in_range(0.5, 0.9999));
+  add_view_output_options(*cmd, args->output, "the window closes, Esc or Ctrl-C");
   cmd->add_flag("!--no-regions", args->regions, "Draw the objects and labels only, not their error regions");
   const std::map<std::string, client::SelectionTechnique> techniques = {
       {"direct", client::SelectionTechnique::direct}, {"two-step", client::SelectionTechnique::two_step}};

@@ -142,13 +142,8 @@ ar::SelectionDrawing ArSelection::frame(const client::ArFrame& frame, const clie
     out << "preselection: " << (session_.preselect() ? "on" : "off") << "\n";
   }
   switch_technique_ = switch_preselect_ = false;
-  // Objects are selected by their outer regions: where the object can be on the screen.
   std::vector<client::Selectable> objects;
-  for (const client::ArObjectFrame& o : frame.objects) {
-    client::Selectable s{o.regions.outer, 0};
-    for (const client::ProjectedVertex& v : o.regions.vertices) s.depth_m += v.depth_m / o.regions.vertices.size();
-    objects.push_back(std::move(s));
-  }
+  for (const client::ArObjectFrame& o : frame.objects) objects.push_back(client::selectable_of(o.regions));
   const std::optional<client::Pointer> tracked = tracked_pointer(graph, now_us);
   while (!script_.empty() && script_.front().t_s <= t_s + 1e-9) {
     pending_.push_back({script_.front().at_px, script_.front().target});

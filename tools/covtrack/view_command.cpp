@@ -27,6 +27,7 @@
 #include "view_background.hpp"
 #include "view_clock.hpp"
 #include "view_log.hpp"
+#include "view_options.hpp"
 #include "view_source.hpp"
 #include "view_video.hpp"
 #include "view_widgets.hpp"
@@ -37,12 +38,7 @@ namespace {
 struct ViewArgs {
   std::string scene_path;
   ViewSourceArgs source;
-  std::string png_path;
-  std::string video_path;
-  std::string background;
-  double duration_s = 0;  // 0: until stopped (window), one frame (--png), the whole --log or 10 s (--video)
-  double fps = 30;
-  double confidence = 0;
+  ViewOutputArgs output;
   client::ProjectionMethod method = client::ProjectionMethod::unscented;
 };
 
@@ -92,12 +88,12 @@ int run_view(const ViewArgs& args) {
     std::cerr << "covtrack view: " << message << "\n";
     return code;
   };
-  const bool window = args.png_path.empty() && args.video_path.empty();
-  const auto video_format = args.video_path.empty() ? Result<VideoFormat>{} : video_format_for(args.video_path);
+  const bool window = args.output.png_path.empty() && args.output.video_path.empty();
+  const auto video_format = args.output.video_path.empty() ? Result<VideoFormat>{} : video_format_for(args.output.video_path);
   if (!video_format) return fail_with(video_format.error().message, program::kExitUsageError);
   if (window && !std::getenv("DISPLAY"))
     return fail_with("no display (DISPLAY is not set): use --png FILE or --video FILE", 2);
-  const auto model = load_regions_model(args.scene_path, args.confidence);
+  const auto model = load_regions_model(args.scene_path, args.output.confidence);
   if (!model) return fail_with(model.error().message, 2);
   auto widgets = ViewWidgets::create(model->scene);
   if (!widgets) return fail_with(fmt::format("{}: {}", args.scene_path, widgets.error().message), 2);
@@ -108,11 +104,11 @@ int run_view(const ViewArgs& args) {
 
   const cv::Size size(model->camera.width_px, model->camera.height_px);
   std::string warning;
-  ViewBackground background(args.background, size, warning);
+  ViewBackground background(args.output.background, size, warning);
   if (background.camera_unavailable()) return fail_with(warning, program::kExitRuntimeError);
   std::optional<cv::VideoWriter> video;
-  if (!args.video_path.empty()) {
-    auto opened = open_video(args.video_path, *video_format, args.fps, size);
+  if (!args.output.video_path.empty()) {
+    auto opened = open_video(args.output.video_path, *video_format, args.output.fps, size);
     if (!opened) return fail_with(opened.error().message, program::kExitRuntimeError);
     video.emplace(std::move(*opened));
   }
@@ -121,8 +117,8 @@ int run_view(const ViewArgs& args) {
   install_stop_signals();
   src.announce();
   // A video of a log covers all of it; one of a scene or of live streams, 10 s.
-  const double duration_s = args.duration_s > 0 ? args.duration_s : (video && !src.log() ? 10.0 : 0.0);
-  const ViewClock clock(args.fps, !src.live() && !window);
+  const double duration_s = args.output.duration_s > 0 ? args.output.duration_s : (video && !src.log() ? 10.0 : 0.0);
+  const ViewClock clock(args.output.fps, !src.live() && !window);
   for (long frame_index = 0;; ++frame_index) {
     const double elapsed_s = clock.frame_time_s(frame_index);
     const auto now = src.advance(elapsed_s);
@@ -133,9 +129,9 @@ int run_view(const ViewArgs& args) {
     // Every frame feeds the Level-of-Error hysteresis, even those --png does not write.
     const WidgetFrame widget_frame = widgets->update(*report, size);
     // --png takes its one frame at the end of --duration (live streams have arrived by then).
-    if (!args.png_path.empty() && !last && duration_s > 0) continue;
+    if (!args.output.png_path.empty() && !last && duration_s > 0) continue;
 
-    cv::Mat image = src.picture(background, args.background.empty(), size, warning);
+    cv::Mat image = src.picture(background, args.output.background.empty(), size, warning);
     if (!warning.empty()) {
       std::cerr << "covtrack view: " << warning << "\n";
       warning.clear();
@@ -145,8 +141,8 @@ int run_view(const ViewArgs& args) {
     draw_regions(image, *report, &widget_frame, legend_height_px(lines.size(), image.rows));
     draw_legend(image, lines);
 
-    if (!args.png_path.empty()) {
-      if (auto r = write_png(image, args.png_path); !r) return fail_with(r.error().message, 1);
+    if (!args.output.png_path.empty()) {
+      if (auto r = write_png(image, args.output.png_path); !r) return fail_with(r.error().message, 1);
       src.report_rejections();
       return 0;
     }
@@ -169,19 +165,7 @@ void add_view_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("view", "Draw the objects' error regions over the camera view");
   cmd->add_option("SCENE", args->scene_path, "Scene file (config/scene_schema.md)")->required();
   add_view_source_options(*cmd, args->source);
-  cmd->add_option("--png", args->png_path, "Write one frame (at the end of --duration, if given) and exit");
-  cmd->add_option("--video", args->video_path,
-                  "Write the frames to this video file: FILE.mp4 (H.264) or FILE.webm (VP9), which browsers play");
-  cmd->add_option("--background", args->background,
-                  "#rrggbb, an image file, a video file (looped) or camera:N (default with --log: the "
-                  "log's camera frames, if it has any)");
-  cmd->add_option("--duration,-d", args->duration_s,
-                  "Seconds to run (default: until q/Esc/Ctrl-C; for --video the whole --log, else 10); offline "
-                  "(no --live) into a file, scene or log seconds rendered without waiting")
-      ->check(program::non_negative());
-  cmd->add_option("--fps", args->fps, "Frames per second")->capture_default_str()->check(program::in_range(0.1, 240.0));
-  cmd->add_option("--confidence", args->confidence, "Confidence of the regions (default: the scene's)")
-      ->check(program::in_range(0.5, 0.9999));
+  add_view_output_options(*cmd, args->output, "q/Esc/Ctrl-C");
   const std::map<std::string, client::ProjectionMethod> methods = {
       {"unscented", client::ProjectionMethod::unscented}, {"linear", client::ProjectionMethod::linear}};
   cmd->add_option("--method", args->method, "Vertex projection: unscented or linear")

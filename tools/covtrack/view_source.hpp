@@ -55,7 +55,6 @@ class ViewSource {
   Result<std::int64_t> advance(double elapsed_s);
 
   bool live() const { return subscriber_ != nullptr; }
-  bool fixed() const { return !live() && !log_; }
   bool finished() const { return log_ && log_->finished(); }  // the log has no events left
   LogFollower* log() { return log_ ? &*log_ : nullptr; }
   const client::TransformGraph& graph() const { return graph_; }

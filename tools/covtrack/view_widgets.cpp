@@ -35,11 +35,7 @@ WidgetFrame ViewWidgets::update(const RegionsReport& report, const cv::Size& scr
   frame.pointer = client::pointer_from_projection(*report.pointer_tip, report.confidence);
   // Objects are selected by their outer regions: where the object can be on the screen.
   std::vector<client::Selectable> selectables;
-  for (const RegionsReport::Object& o : report.objects) {
-    client::Selectable s{o.regions.outer, 0};
-    for (const client::ProjectedVertex& v : o.regions.vertices) s.depth_m += v.depth_m / o.regions.vertices.size();
-    selectables.push_back(std::move(s));
-  }
+  for (const RegionsReport::Object& o : report.objects) selectables.push_back(client::selectable_of(o.regions));
   frame.likelihoods = *likelihood_ == scene::Likelihood::area
                           ? client::likelihoods_by_area(*frame.pointer, selectables)
                           : client::likelihoods_by_distance(*frame.pointer, selectables);

@@ -43,6 +43,10 @@ struct Selectable {
   double depth_m = 0;  // distance from the camera, breaks ties (nearer first)
 };
 
+// An object selected by its outer region (where it can be on the screen), at the mean
+// depth of its vertices.
+Selectable selectable_of(const ObjectRegions& regions);
+
 // A pointer without area (a point) gives 1 inside the region and 0 outside.
 std::vector<double> likelihoods_by_area(const Pointer& pointer, std::span<const Selectable> objects);
 std::vector<double> likelihoods_by_distance(const Pointer& pointer,
