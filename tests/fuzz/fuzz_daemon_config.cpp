@@ -1,0 +1,18 @@
+// covtrackd's TOML config as the daemon reads it at start (files it names are not
+// opened, devices never): every section, every driver's keys.
+#include "config.hpp"
+#include "fuzz/fuzz_support.hpp"
+
+using namespace covtrack;
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const fuzz::Input input({data, size});
+  const auto config = server::parse_config(input.rest_text(), "fuzz.toml");
+  if (!config) {
+    FUZZ_CHECK(!config.error().message.empty());
+    return 0;
+  }
+  for (const auto& device : config->devices) FUZZ_CHECK(!device.name.empty() && device.make);
+  FUZZ_CHECK(config->daemon.heartbeat_hz > 0 && fuzz::finite(config->daemon.heartbeat_hz));
+  return 0;
+}
