@@ -13,7 +13,8 @@ packages=(build-essential cmake pkg-config liblcm-dev liblcm-bin libeigen3-dev
           iproute2 util-linux python3-dev pybind11-dev python3-numpy python3-pytest
           default-jdk-headless liblcm-java libjchart2d-java
           libopenscenegraph-dev libgl1-mesa-dri  # the 3-D AR adapter; Mesa draws its tests
-          file)  # file: cpack -G DEB finds the ELF files for dpkg-shlibdeps with it
+          file  # file: cpack -G DEB finds the ELF files for dpkg-shlibdeps with it
+          clang-16 libclang-rt-16-dev)  # the fuzzers and the sanitized tests (libFuzzer, ASan, UBSan)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,5 +1,6 @@
-// covtrackd's TOML config as the daemon reads it at start (files it names are not
-// opened, devices never): every section, every driver's keys.
+// covtrackd's TOML config as the daemon reads it at start: every section, every driver's
+// keys; devices are never opened, and of the files a config names only those a driver
+// reads with its config (a Lenz layout). Relative paths resolve against config/.
 #include "config.hpp"
 #include "fuzz/fuzz_support.hpp"
 
@@ -7,7 +8,7 @@ using namespace covtrack;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const fuzz::Input input({data, size});
-  const auto config = server::parse_config(input.rest_text(), "fuzz.toml");
+  const auto config = server::parse_config(input.rest_text(), COVTRACK_SOURCE_DIR "/config/fuzz.toml");
   if (!config) {
     FUZZ_CHECK(!config.error().message.empty());
     return 0;

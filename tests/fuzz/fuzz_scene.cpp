@@ -1,7 +1,7 @@
 // Scene files (config/scenes/*.toml) as `covtrack regions` and `view` read them: parsed,
 // their transforms put into a transform graph with every tracked edge reporting, and
 // each object's 3-D hull built. Files a scene names (calibration, transform tables) are
-// looked for in this harness's corpus folder.
+// looked for beside the shipped scenes (config/scenes/).
 #include "covtrack/scene/scene.hpp"
 #include "covtrack/scene/scene_graph.hpp"
 #include "fuzz/fuzz_support.hpp"
@@ -10,7 +10,7 @@ using namespace covtrack;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const fuzz::Input input({data, size});
-  const auto scene = scene::parse_scene(input.rest_text(), "fuzz.toml", COVTRACK_FUZZ_SCENE_DIR);
+  const auto scene = scene::parse_scene(input.rest_text(), "fuzz.toml", COVTRACK_SOURCE_DIR "/config/scenes");
   if (!scene) {
     FUZZ_CHECK(!scene.error().message.empty());
     return 0;
