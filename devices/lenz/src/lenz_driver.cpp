@@ -25,6 +25,8 @@ template <class... F>
 struct overloaded : F... {
   using F::operator()...;
 };
+template <class... F>
+overloaded(F...) -> overloaded<F...>;  // clang before 17 deduces no aggregate's arguments
 
 // A held feedback change (feedback_confirmation.hpp) is asked for again at once; an
 // interface answers within tens of milliseconds, so one not confirmed in this long is
