@@ -160,6 +160,19 @@ TEST(FastrakDecoder, RejectsNonFiniteAndNonUnitQuaternion) {
   EXPECT_FALSE(d.last_problem().empty());
 }
 
+// Found by fuzz_fastrak: the timestamp item is a float, and a NaN there passed.
+TEST(FastrakDecoder, RejectsNonFiniteTimestamp) {
+  const FastrakFormat f{Units::Centimetres, {FastrakExtra::Timestamp}, true};
+  TrackerRecord nan_time = sample_record(1);
+  nan_time.device_time_s = std::nan("");
+  FastrakDecoder d(f);
+  auto recs = records_of(d, encode_fastrak_record(nan_time, f) + encode_fastrak_record(sample_record(2), f));
+  ASSERT_EQ(recs.size(), 1u);
+  EXPECT_EQ(recs[0].station, 2);
+  EXPECT_EQ(d.bad_records(), 1u);
+  EXPECT_NE(d.last_problem().find("non-finite"), std::string::npos);
+}
+
 TEST(FastrakDecoder, OutputListCommand) {
   EXPECT_EQ(fastrak_output_list_command(2, {Units::Inches, {FastrakExtra::Timestamp}, true}),
             "O2,2,11,21,1\r");

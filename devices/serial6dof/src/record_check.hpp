@@ -18,7 +18,8 @@ constexpr double kMaxRange_m = 100;
 
 inline std::optional<std::string> record_problem(const TrackerRecord& r) {
   const auto& q = r.orientation;
-  if (!r.position_m.allFinite() || !q.coeffs().allFinite())
+  if (!r.position_m.allFinite() || !q.coeffs().allFinite() ||
+      (r.device_time_s && !std::isfinite(*r.device_time_s)))  // a float timestamp can be NaN too
     return fmt::format("station {}: non-finite number in record", r.station);
   if (std::abs(q.norm() - 1.0) > kQuaternionNormTolerance)
     return fmt::format("station {}: quaternion norm {:.4f} is not 1", r.station, q.norm());
