@@ -62,12 +62,15 @@ void feed_in_chunks(std::span<const std::uint8_t> data, std::uint8_t seed, std::
   }
 }
 
-// A file of this process's own in $TMPDIR (or /tmp), rewritten for each input.
+// A file of this process's own, rewritten for each input: in /dev/shm when there is one
+// (rewriting a file on disk cost 2.4 ms an input, 100 times more than in memory), else
+// in $TMPDIR or /tmp.
 class ScratchFile {
  public:
   explicit ScratchFile(const char* suffix) {
-    const char* dir = std::getenv("TMPDIR");
-    path_ = std::string(dir && *dir ? dir : "/tmp") + "/covtrack_fuzz_XXXXXX" + suffix;
+    const char* tmpdir = std::getenv("TMPDIR");
+    const std::string dir = ::access("/dev/shm", W_OK) == 0 ? "/dev/shm" : tmpdir && *tmpdir ? tmpdir : "/tmp";
+    path_ = dir + "/covtrack_fuzz_XXXXXX" + suffix;
     const int fd = ::mkstemps(path_.data(), static_cast<int>(std::string_view(suffix).size()));
     if (fd < 0) invariant_failed("cannot create a scratch file", __FILE__, __LINE__);
     ::close(fd);
