@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Builds the fuzz harnesses for libFuzzer with AddressSanitizer and UBSan (clang 16, the
-# instrumented tree of tests/configure_sanitized.sh) and runs each one for a bounded time over its checked-in
-# corpus (tests/fuzz/corpus/<name>/). Fails when any harness finds a crash, a leak, a
-# sanitizer report, a broken invariant, a timeout or an out-of-memory input.
+# Builds the fuzz harnesses for libFuzzer with AddressSanitizer and UBSan (clang 16, in
+# the instrumented tree of tests/configure_sanitized.sh) and runs each one for a bounded
+# time over its checked-in corpus (tests/fuzz/corpus/<name>/). Fails when any harness
+# finds a crash, a leak, a sanitizer report, a broken invariant, a timeout or an
+# out-of-memory input.
 #
 #   tests/fuzz/run_fuzzers.sh [--seconds N] [--build DIR] [--jobs J] [--no-build] [NAME...]
 #
@@ -15,7 +16,7 @@
 # input that fails is written to DIR/fuzz/artifacts/<name>-crash-<sha1> (or -leak-,
 # -timeout-, -oom-), its log to DIR/fuzz/logs/<name>.log. Reproduce one with
 #   DIR/tests/fuzz/fuzz_<name> DIR/fuzz/artifacts/<name>-crash-<sha1>
-# docs/design.md ("Fuzzing") says how to keep it as a regression input.
+# docs/design.md ("Fuzzing and sanitizers") says how to keep it as a regression input.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 seconds=20 build=build-sanitize jobs=$(nproc) do_build=1 names=()
