@@ -10,7 +10,7 @@ tools/setup.sh build
 failed=()
 ctest --test-dir build --output-on-failure -j"$(nproc)" || failed+=(tests)
 tests/sanitized_tests.sh build-sanitize || failed+=(sanitized-tests)
-tests/fuzz/run_fuzzers.sh --build build-sanitize --seconds 20 || failed+=(fuzzers)
+tests/fuzz/run_fuzzers.sh --build build-sanitize --seconds 15 || failed+=(fuzzers)
 if ((${#failed[@]})); then
   echo "test.sh: FAILED: ${failed[*]}" >&2
   exit 1
