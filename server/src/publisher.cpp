@@ -19,7 +19,8 @@ bool Publisher::send(const std::string& channel, const Msg& msg) {
   const int size = msg.getEncodedSize();
   buffer_.resize(static_cast<std::size_t>(size));
   if (msg.encode(buffer_.data(), 0, size) != size) return false;
-  return lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(size)) == 0;
+  if (signer_) signer_->sign(channel, buffer_);
+  return lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(buffer_.size())) == 0;
 }
 
 bool Publisher::pose(const std::string& device, const PoseSample& s) {
