@@ -192,7 +192,7 @@ int run_echo(const EchoOptions& o) {
     if (o.duration_s > 0 && now - start >= std::chrono::duration<double>(o.duration_s)) break;
     if (!hinted && now >= hint_at) {
       hinted = true;
-      if ((*sub)->streams().empty() && (*sub)->devices().empty())
+      if ((*sub)->streams().empty() && (*sub)->devices().empty() && (*sub)->rejections().total == 0)
         std::cerr << fmt::format("covtrack echo: nothing received for {} s on {} (streams '{}'): is covtrackd "
                                  "running and publishing there? (covtrackd --config config/sim.toml); still waiting, Ctrl-C ends\n",
                                  kSilenceHint.count(), effective_lcm_url(o.subscriber.lcm_url),
