@@ -385,8 +385,7 @@ TEST_F(SubscriberTest, WithAKeyOnlyAuthenticFreshMessagesAreDelivered) {
   MessageSigner signer(*key, 5);
   const std::string channel = pose_channel("dev", "s");
   auto publish_bytes = [&](const pose_cov_t& m, bool sign) {
-    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
-    m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    auto bytes = test::encoded(m);
     if (sign) signer.sign(channel, bytes);
     lcm_->publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
     return bytes;

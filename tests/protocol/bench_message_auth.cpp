@@ -10,9 +10,9 @@
 
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/message_auth.hpp"
-#include "covtrack/protocol/pose_message.hpp"
 #include "covtrack/protocol/replay_guard.hpp"
 #include "covtrack/protocol/wire_decode.hpp"
+#include "client/pose_messages.hpp"
 
 using namespace covtrack;
 
@@ -20,24 +20,9 @@ namespace {
 
 const std::string kChannel = "covtrack/pose/optical/head";
 
-pose_cov_t pose() {
-  pose_cov_t m{};
-  m.device = "optical";
-  m.sensor = "head";
-  m.parent_frame = "world";
-  m.child_frame = "head";
-  m.sequence = 1;
-  m.measurement_time_us = m.publish_time_us = now_us();
-  set_pose(m, Pose::Identity(), Mat6::Identity() * 1e-6);
-  return m;
-}
+pose_cov_t pose() { return test::pose_message("optical", "head", 1); }
 
-std::vector<std::uint8_t> encoded() {
-  const pose_cov_t m = pose();
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(out.data(), 0, static_cast<int>(out.size()));
-  return out;
-}
+std::vector<std::uint8_t> encoded() { return test::encoded(pose()); }
 
 AuthKey key() {
   AuthKey k;

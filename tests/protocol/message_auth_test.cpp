@@ -11,9 +11,9 @@
 
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/message_auth.hpp"
-#include "covtrack/protocol/pose_message.hpp"
 #include "covtrack/protocol/replay_guard.hpp"
 #include "covtrack/protocol/wire_decode.hpp"
+#include "client/pose_messages.hpp"
 
 using namespace covtrack;
 
@@ -34,18 +34,7 @@ AuthKey new_key(const std::string& name) {
   return key.value_or(AuthKey{});
 }
 
-std::vector<std::uint8_t> encoded_pose() {
-  pose_cov_t m{};
-  m.device = "dev";
-  m.sensor = "head";
-  m.parent_frame = "world";
-  m.child_frame = "head";
-  m.sequence = 7;
-  set_pose(m, Pose::Identity(), Mat6::Identity() * 1e-6);
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(out.data(), 0, static_cast<int>(out.size()));
-  return out;
-}
+std::vector<std::uint8_t> encoded_pose() { return test::encoded(test::pose_message("dev", "head", 7)); }
 
 std::span<const std::byte> bytes(const std::vector<std::uint8_t>& v) { return bytes_of(v.data(), v.size()); }
 

@@ -6,7 +6,6 @@
 // heard, sent long ago). A Subscriber without the key receives the same streams as
 // before, and `covtrack echo --key-file` reports the same counts.
 #include <gtest/gtest.h>
-#include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -22,6 +21,7 @@
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/message_auth.hpp"
+#include "client/pose_messages.hpp"
 #include "daemon_process.hpp"
 
 using namespace covtrack;
@@ -88,54 +88,8 @@ class Capture {
   std::vector<std::vector<std::uint8_t>> captured_;
 };
 
-// `covtrack echo` with its stderr in a file, until stop().
-class EchoProcess {
- public:
-  EchoProcess(const std::vector<std::string>& args, const std::string& output_path) {
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int out = ::open(output_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(out, STDERR_FILENO);
-      const int null = ::open("/dev/null", O_WRONLY);
-      dup2(null, STDOUT_FILENO);
-      std::vector<char*> argv{const_cast<char*>(kCovtrack.c_str())};
-      for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-      argv.push_back(nullptr);
-      execv(kCovtrack.c_str(), argv.data());
-      _exit(127);
-    }
-  }
-  ~EchoProcess() {
-    if (pid_ > 0 && !stopped_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  int stop() {
-    kill(pid_, SIGINT);
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    stopped_ = true;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-
- private:
-  pid_t pid_ = -1;
-  bool stopped_ = false;
-};
-
 std::vector<std::uint8_t> plain_pose(std::int64_t sequence) {
-  pose_cov_t m{};
-  m.device = "optical";
-  m.sensor = "head";
-  m.parent_frame = "world";
-  m.child_frame = "head";
-  m.sequence = sequence;
-  m.measurement_time_us = m.publish_time_us = now_us();
-  set_pose(m, Pose::Identity(), Mat6::Identity() * 1e-6);
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(out.data(), 0, static_cast<int>(out.size()));
-  return out;
+  return test::encoded(test::pose_message("optical", "head", sequence));
 }
 
 }  // namespace
@@ -154,7 +108,7 @@ TEST(AuthenticatedPoses, ForgedUnauthenticatedAndReplayedMessagesAreRefusedAndCo
   ASSERT_FALSE((*plain)->authentication());
   Capture capture;
   const std::string echo_log = temp_path("echo.log");
-  EchoProcess echo({"echo", "--lcm-url", kUrl, "--key-file", key_file}, echo_log);
+  test::DaemonProcess echo(kCovtrack, {"echo", "--lcm-url", kUrl, "--key-file", key_file}, echo_log);
   ASSERT_TRUE(wait_for([&] { return read_file(echo_log).find("listening on") != std::string::npos; }))
       << read_file(echo_log);
 
@@ -175,7 +129,7 @@ TEST(AuthenticatedPoses, ForgedUnauthenticatedAndReplayedMessagesAreRefusedAndCo
   auto inject = [&](const std::vector<std::uint8_t>& bytes) {
     ASSERT_EQ(injector.publish(kChannel, bytes.data(), static_cast<unsigned>(bytes.size())), 0);
   };
-  // Forged: one altered byte of the pose (its x position); a pose signed with another key.
+  // Forged: one altered byte of a captured pose (in its covariance); a pose signed with another key.
   auto altered = captured[1];
   altered[altered.size() - kAuthTrailerBytes - 8] ^= 0x40;
   inject(altered);
@@ -221,7 +175,9 @@ TEST(AuthenticatedPoses, ForgedUnauthenticatedAndReplayedMessagesAreRefusedAndCo
   const auto before = received(**keyed, head);
   EXPECT_TRUE(wait_for([&] { return received(**keyed, head) >= before + 20; }));
 
-  ASSERT_EQ(echo.stop(), 0);
+  int status = -1;
+  ASSERT_GE(echo.stop(SIGINT, status), 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
   const std::string out = read_file(echo_log);
   EXPECT_NE(out.find("authenticated messages only (key " + key_file + ")"), std::string::npos) << out;
   EXPECT_NE(out.find("refused 2 unauthenticated, 2 forged, 6 replayed"), std::string::npos) << out;
