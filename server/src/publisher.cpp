@@ -1,5 +1,10 @@
 #include "publisher.hpp"
 
+#include <cerrno>
+#include <cstring>
+
+#include <spdlog/spdlog.h>
+
 #include <covtrack/image_t.hpp>
 #include <covtrack/pose_cov_t.hpp>
 #include <covtrack/raw_bytes_t.hpp>
@@ -20,7 +25,23 @@ bool Publisher::send(const std::string& channel, const Msg& msg) {
   buffer_.resize(static_cast<std::size_t>(size));
   if (msg.encode(buffer_.data(), 0, size) != size) return false;
   if (signer_) signer_->sign(channel, buffer_);
-  return lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(buffer_.size())) == 0;
+  errno = 0;
+  const bool sent = lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(buffer_.size())) == 0;
+  log_send_outcome(sent, channel, errno);
+  return sent;
+}
+
+void Publisher::log_send_outcome(bool sent, const std::string& channel, int error) {
+  if (sent && unsent_ > 0) {
+    const std::chrono::duration<double> lasted = std::chrono::steady_clock::now() - failing_since_;
+    spdlog::info("covtrackd: publishing again; {} message(s) were not sent in the last {:.1f} s", unsent_,
+                 lasted.count());
+    unsent_ = 0;
+  } else if (!sent && unsent_++ == 0) {
+    failing_since_ = std::chrono::steady_clock::now();
+    spdlog::warn("covtrackd: cannot publish on {} ({}): messages are lost until the network is back",
+                 channel, error != 0 ? std::strerror(error) : "LCM gave no reason");
+  }
 }
 
 bool Publisher::pose(const std::string& device, const PoseSample& s) {

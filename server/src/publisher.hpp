@@ -3,6 +3,7 @@
 // stamps publish time and the per-stream sequence numbers, which survive driver restarts
 // so that a client sees a gap only when a message was really lost. With a key, it signs
 // every message (message_auth.hpp).
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <mutex>
@@ -41,6 +42,10 @@ class Publisher {
   std::int64_t next_sequence(const std::string& channel);
   template <typename Msg>
   bool send(const std::string& channel, const Msg& msg);
+  // While the host has no route to the group (its interface down, say), every send fails
+  // and no heartbeat reaches anyone: the log says so when it starts and when it ends,
+  // not once per message.
+  void log_send_outcome(bool sent, const std::string& channel, int error);
 
   lcm::LCM& lcm_;
   std::optional<MessageSigner> signer_;  // under mutex_, which orders its counter as the sends
@@ -48,6 +53,8 @@ class Publisher {
   std::mutex mutex_;  // LCM's publish is thread-safe; this guards the counters and buffer
   std::unordered_map<std::string, std::int64_t> sequences_;
   std::vector<std::uint8_t> buffer_;
+  std::int64_t unsent_ = 0;  // messages not sent since sending last failed, 0 while it works
+  std::chrono::steady_clock::time_point failing_since_;
 };
 
 }  // namespace covtrack::server
