@@ -10,6 +10,8 @@
 #include <thread>
 #include <unordered_map>
 
+#include <fmt/format.h>
+
 #include "covtrack/client/pose_validation.hpp"
 #include "covtrack/client/sequence_tracker.hpp"
 #include "covtrack/protocol/channel_messages.hpp"
@@ -30,6 +32,8 @@ constexpr std::int64_t kDrainUs = 200'000;
 constexpr int kStatusQueueCapacity = 1000;
 // Batches of datagrams read per wake-up before the clock is checked for silence.
 constexpr int kBatchesPerWake = 16;
+// The largest SubscriberOptions::auth_max_age_s: a day is no protection against replays already.
+constexpr double kMaxAuthAgeS = 86400;
 // Channels whose verdict is remembered; the bus has few, a flood of made-up ones resets it.
 constexpr std::size_t kChannelVerdicts = 4096;
 
@@ -335,9 +339,12 @@ Result<std::unique_ptr<Subscriber>> Subscriber::attach(std::shared_ptr<lcm::LCM>
 Result<std::unique_ptr<Subscriber>> Subscriber::start(std::unique_ptr<Impl> impl) {
   if (const std::string key_file = effective_key_file(impl->options.key_file); !key_file.empty()) {
     auto key = load_auth_key(key_file);
-    if (!key || !(impl->options.auth_max_age_s > 0)) {
+    const double max_age_s = impl->options.auth_max_age_s;
+    if (!key || !(max_age_s > 0 && max_age_s <= kMaxAuthAgeS)) {  // also refuses NaN
       impl->unsubscribe();
-      return key ? fail("Subscriber: auth_max_age_s must be above 0") : std::unexpected(key.error());
+      return key ? fail(fmt::format("Subscriber: auth_max_age_s must be above 0 and at most {} s, got {}",
+                                    kMaxAuthAgeS, max_age_s))
+                 : std::unexpected(key.error());
     }
     impl->key = *key;
     impl->replay_guard.emplace(impl->options.auth_max_age_s);

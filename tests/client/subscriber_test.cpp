@@ -409,3 +409,19 @@ TEST_F(SubscriberTest, WithAKeyOnlyAuthenticFreshMessagesAreDelivered) {
   EXPECT_EQ(counters("dev", "s").foreign, 0);
   EXPECT_EQ(sub_->rejections().total, 3);
 }
+
+TEST_F(SubscriberTest, AnUnusableKeyFileOrMaxAgeIsRefusedAtOpen) {
+  const std::string key_file = ::testing::TempDir() + "/subscriber_test_age_" + std::to_string(::getpid()) + ".key";
+  ::unlink(key_file.c_str());
+  ASSERT_TRUE(write_new_auth_key(key_file));
+  sub_.reset();
+  for (double age : {0.0, -1.0, std::numeric_limits<double>::infinity(), std::nan("")}) {
+    auto s = client::Subscriber::attach(lcm_, {.key_file = key_file, .auth_max_age_s = age});
+    ASSERT_FALSE(s) << age;
+    EXPECT_NE(s.error().message.find("auth_max_age_s"), std::string::npos) << s.error().message;
+  }
+  auto missing = client::Subscriber::attach(lcm_, {.key_file = key_file + ".absent"});
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().message.find("No such file"), std::string::npos) << missing.error().message;
+  EXPECT_TRUE(client::Subscriber::attach(lcm_, {.key_file = key_file}));
+}

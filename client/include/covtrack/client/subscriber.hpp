@@ -74,6 +74,7 @@ struct SubscriberOptions {
   // With a key: the oldest an authenticated message may be by its sender's clock (and
   // the farthest in the future), so a message captured earlier cannot be replayed from
   // a daemon instance this subscriber never heard from; hosts' clocks must agree within it.
+  // Above 0, at most a day.
   double auth_max_age_s = 2.0;
 };
 
