@@ -1,7 +1,8 @@
 # The SDK that `cmake --install` puts under the prefix: the client, protocol and log
 # libraries (static, position independent), their headers and the LCM message headers
 # they include, a CMake package (find_package(covtrack): covtrack::client,
-# covtrack::protocol, covtrack::log, covtrack::camera) and covtrack.pc. docs/sdk.md.
+# covtrack::protocol, covtrack::log, covtrack::camera; covtrack::osg when built) and
+# covtrack.pc. docs/sdk.md.
 # Everything here is the "dev" component; the programs are "runtime", the Python module
 # "python".
 include(GNUInstallDirs)
@@ -23,6 +24,17 @@ install(DIRECTORY protocol/include/ client/include/ tools/lcmlog/include/
 install(DIRECTORY ${PROJECT_BINARY_DIR}/protocol/lcmgen/covtrack
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT dev FILES_MATCHING PATTERN "*.hpp")
 install(EXPORT covtrackTargets NAMESPACE covtrack:: DESTINATION ${COVTRACK_CMAKE_DIR} COMPONENT dev)
+
+# The OpenSceneGraph adapter, when it was built: find_package(covtrack COMPONENTS osg)
+# gives covtrack::osg (its own export set, so that the rest needs no OpenSceneGraph).
+if(TARGET covtrack_osg)
+  set_target_properties(covtrack_osg PROPERTIES EXPORT_NAME osg)
+  install(TARGETS covtrack_osg EXPORT covtrackOsgTargets
+          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
+          INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  install(DIRECTORY client/osg/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT dev)
+  install(EXPORT covtrackOsgTargets NAMESPACE covtrack:: DESTINATION ${COVTRACK_CMAKE_DIR} COMPONENT dev)
+endif()
 
 configure_package_config_file(cmake/covtrackConfig.cmake.in ${PROJECT_BINARY_DIR}/covtrackConfig.cmake
                               INSTALL_DESTINATION ${COVTRACK_CMAKE_DIR})

@@ -2,7 +2,8 @@
 # The SDK as a user gets it: `cmake --install` of the build tree into a fresh prefix, the
 # examples/ built out of tree against it (find_package(covtrack)), one file built with
 # pkg-config alone, and the programs run from the prefix. Run inside a private network
-# namespace (tests/netns_run.sh): the live examples subscribe to the installed covtrackd.
+# namespace (tests/netns_run.sh): the live examples subscribe to the installed covtrackd;
+# and on an X server of its own (tests/with_xvfb.sh) for the 3-D example.
 # Usage: sdk_install_test.sh BUILD_DIR SOURCE_DIR CMAKE CXX PYTHON   (PYTHONPATH: the build's module)
 set -eu
 build=$1 src=$2 cmake=$3 cxx=$4 python=$5
@@ -31,6 +32,16 @@ grep -qx "ExecStart=$prefix/bin/covtrackd --config $prefix/etc/covtrack/covtrack
   || { cat "$tmp/configure.log"; fail "configuring examples/"; }
 grep -q "^covtrack_DIR:PATH=$prefix/" "$tmp/examples/CMakeCache.txt" || fail "covtrack found outside $prefix"
 "$cmake" --build "$tmp/examples" -j2 >"$tmp/build.log" 2>&1 || { cat "$tmp/build.log"; fail "building examples/"; }
+
+# The 3-D overlay (covtrack::osg) when the SDK has it: drawn off screen on the test's X
+# server (tests/with_xvfb.sh), the crate covering part of the picture.
+if [ -f "$prefix/lib/cmake/covtrack/covtrackOsgTargets.cmake" ]; then
+  [ -x "$tmp/examples/ar_overlay" ] || fail "covtrack::osg installed but examples/ar_overlay not built"
+  "$tmp/examples/ar_overlay" "$tmp/overlay.ppm" >"$tmp/overlay.txt" 2>&1 || { cat "$tmp/overlay.txt"; fail "ar_overlay"; }
+  drawn=$(sed -n 's/^crate: outer region [0-9]* corners, inner [0-9]*, \([0-9]*\) pixels drawn over the video$/\1/p' "$tmp/overlay.txt")
+  [ "${drawn:-0}" -gt 3000 ] || { cat "$tmp/overlay.txt"; fail "ar_overlay drew too little of the crate"; }
+  [ "$(head -c 15 "$tmp/overlay.ppm" | tr '\n' ' ')" = "P6 640 480 255 " ] || fail "ar_overlay's image is not 640x480"
+fi
 
 # read_log on a recorded session and on a truncated copy, against the Python module's reading.
 log=$src/tests/data/lenz_session.lcm

@@ -149,34 +149,12 @@ TEST_F(ArCli, MistakesAreReported) {
 // crate's middle selects it; a click where both may be lays out a target each, and a
 // click on a target picks its crate; direct selection picks the more likely at once.
 TEST_F(ArCli, ScriptedClicksSelectTheIntendedCrate) {
-  const std::string scene = (dir_ / "crates.toml").string();
-  std::ofstream(scene) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR
-                          "/config/cameras/rendered_640x480.yml\"\n"
-                          "[[transform]]\nparent = \"camera\"\nchild = \"left\"\nposition_m = [-0.046, 0, 0.5]\n"
-                          "sigma_m = [0.003, 0.003, 0.003]\nsigma_rad = [0.01, 0.01, 0.01]\n"
-                          "[[transform]]\nparent = \"camera\"\nchild = \"right\"\nposition_m = [0.046, 0, 0.5]\n"
-                          "sigma_m = [0.003, 0.003, 0.003]\nsigma_rad = [0.01, 0.01, 0.01]\n"
-                          "[[object]]\nname = \"left_crate\"\nframe = \"left\"\nbox_m = [0.08, 0.06, 0.04]\n"
-                          "[[object]]\nname = \"right_crate\"\nframe = \"right\"\nbox_m = [0.08, 0.06, 0.04]\n";
-  const CliRun regions = run_covtrack("regions " + scene + " --json");
-  ASSERT_EQ(regions.exit_code, 0) << regions.out;
-  const nlohmann::json doc = nlohmann::json::parse(regions.out, nullptr, false);
-  ASSERT_FALSE(doc.is_discarded());
-  const nlohmann::json& left = doc["objects"][0]["outer_px"];
-  const nlohmann::json& right = doc["objects"][1]["outer_px"];
-  // A pixel in both outer regions, and the middle of the left crate's inner region.
-  std::optional<std::pair<int, int>> both;
-  for (int v = 0; v < 480 && !both; ++v)
-    for (int u = 0; u < 640 && !both; ++u)
-      if (json_polygon_contains(left, u, v, 0) && json_polygon_contains(right, u, v, 0)) both = {u, v};
-  ASSERT_TRUE(both) << "the crates' outer regions must overlap for this test";
-  double cu = 0, cv = 0;
-  for (const auto& p : doc["objects"][0]["inner_px"]) cu += p[0].get<double>(), cv += p[1].get<double>();
-  cu /= doc["objects"][0]["inner_px"].size(), cv /= doc["objects"][0]["inner_px"].size();
-
-  const std::string at_both = std::to_string(both->first) + "," + std::to_string(both->second);
+  const auto crates = write_crates_scene(dir_);
+  ASSERT_TRUE(crates) << "the crates' regions, overlapping";
+  const std::string& scene = crates->path;
+  const std::string& at_both = crates->in_both_px;
   const std::string png = " --png " + (dir_ / "s.png").string() + " --duration 1";
-  CliRun r = run_covtrack("ar " + scene + png + " --click " + std::to_string(cu) + "," + std::to_string(cv) +
+  CliRun r = run_covtrack("ar " + scene + png + " --click " + crates->left_middle_px +
                           "@0.1 --click " + at_both + "@0.2 --click target:right_crate@0.3");
   ASSERT_EQ(r.exit_code, 0) << r.out;
   EXPECT_NE(r.out.find("selected left_crate (two-step)"), std::string::npos) << r.out;

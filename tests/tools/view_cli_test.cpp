@@ -134,6 +134,57 @@ TEST(ViewCli, PictureShowsInnerRegionsInsideOuterRegions) {
   std::filesystem::remove(png);
 }
 
+// Selection with a user, scripted (the window's mouse and keys drive the same session):
+// a click on one crate selects it and outlines it in orange; a click where both crates
+// may be lays out a target each, and a click on a target picks its crate; direct
+// selection picks at once; a click that cannot be read is a usage error.
+TEST(ViewCli, ScriptedClicksSelectTheIntendedCrate) {
+  const auto crates = write_crates_scene(kTmp);
+  ASSERT_TRUE(crates) << "the crates' regions, overlapping";
+  const std::string png = (kTmp / "covtrack_view_selection.png").string();
+  const std::string view = "view " + crates->path + " --png " + png + " --duration 1";
+  CliRun r = run(view + " --click " + crates->left_middle_px + "@0.1 --click " + crates->in_both_px +
+                 "@0.2 --click target:right_crate@0.3");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("selected left_crate (two-step)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("targets: pick one of 2: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("selected right_crate (two-step)"), std::string::npos) << r.out;
+  EXPECT_LT(r.out.find("selected left_crate"), r.out.find("targets:")) << "in the order clicked: " << r.out;
+  // The picture, taken after the last click: the right crate's outline is orange, the
+  // left crate's is not.
+  const cv::Mat image = cv::imread(png, cv::IMREAD_COLOR);
+  ASSERT_FALSE(image.empty());
+  int orange_left = 0, orange_right = 0;
+  const nlohmann::json& objects = crates->regions["objects"];
+  for (int y = 0; y < image.rows; ++y)
+    for (int x = 0; x < image.cols; ++x) {
+      const cv::Vec3b p = image.at<cv::Vec3b>(y, x);  // BGR
+      if (p[0] > 40 || p[1] < 120 || p[1] > 180 || p[2] < 220) continue;
+      orange_left += json_polygon_contains(objects[0]["outer_px"], x, y, 1) &&
+                     !json_polygon_contains(objects[1]["outer_px"], x, y, 1);
+      orange_right += json_polygon_contains(objects[1]["outer_px"], x, y, 1) &&
+                      !json_polygon_contains(objects[0]["outer_px"], x, y, 1);
+    }
+  std::printf("orange pixels: left crate alone %d, right crate alone %d\n", orange_left, orange_right);
+  EXPECT_GT(orange_right, 300);
+  EXPECT_LT(orange_left, 10);  // anti-aliased edges of other colours can blend into orange's range
+
+  r = run(view + " --selection direct --click " + crates->in_both_px + "@0.1 --click target:left_crate@0.2");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("(direct)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("targets:"), std::string::npos) << "direct selection lays out no targets: " << r.out;
+  EXPECT_NE(r.out.find("no target of 'left_crate' is shown"), std::string::npos) << r.out;
+
+  r = run(view + " --click pointer@0.1");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("the scene has no tracked pointer"), std::string::npos) << r.out;
+
+  r = run(view + " --click 12@0.1");
+  EXPECT_EQ(r.exit_code, 2) << r.out;  // a usage error
+  EXPECT_NE(r.out.find("expected U,V@T"), std::string::npos) << r.out;
+  std::filesystem::remove(png);
+}
+
 // The tool-box demo 4.5 s into its loop (shaded regions, leader lines, the pointer between
 // drawers with its targets), against a reviewed picture. Offline frames are rendered at
 // their scene times, so the picture is the same on every run; the tolerance covers

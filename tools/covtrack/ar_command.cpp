@@ -39,8 +39,7 @@ struct ArArgs {
   ViewSourceArgs source;
   ViewOutputArgs output;
   bool regions = true;
-  client::SelectionTechnique technique = client::SelectionTechnique::two_step;
-  std::vector<std::string> clicks;
+  SelectionArgs selection;
 };
 
 int run_ar(const ArArgs& args) {
@@ -65,13 +64,9 @@ int run_ar(const ArArgs& args) {
     if (!levels) return fail_with(fmt::format("{}: {}", args.scene_path, levels.error().message), 2);
     scene.add_object(std::move(*levels));
   }
-  std::vector<ScriptedClick> script;
-  for (const std::string& text : args.clicks) {
-    auto click = parse_click(text);
-    if (!click) return fail_with(click.error().message, program::kExitUsageError);
-    script.push_back(*click);
-  }
-  osg::ref_ptr<ArSelection> selection = new ArSelection(*model, args.technique, std::move(script));
+  auto input = SelectionInput::create(model->scene, model->camera, model->confidence, args.selection);
+  if (!input) return fail_with(input.error().message, program::kExitUsageError);
+  osg::ref_ptr<ArSelection> selection = new ArSelection(*model, std::move(*input));
   auto viewer = ar::ArViewer::open(scene, window ? ar::ArViewer::Output::window : ar::ArViewer::Output::offscreen);
   if (!viewer) return fail_with(viewer.error().message, program::kExitRuntimeError);
   (*viewer)->add_event_handler(selection.get());
@@ -139,16 +134,7 @@ void add_ar_command(CLI::App& app) {
   add_view_source_options(*cmd, args->source);
   add_view_output_options(*cmd, args->output, "the window closes, Esc or Ctrl-C");
   cmd->add_flag("!--no-regions", args->regions, "Draw the objects and labels only, not their error regions");
-  const std::map<std::string, client::SelectionTechnique> techniques = {
-      {"direct", client::SelectionTechnique::direct}, {"two-step", client::SelectionTechnique::two_step}};
-  cmd->add_option("--selection", args->technique,
-                  "direct (a click picks the most likely object) or two-step (a click on several lays out a "
-                  "target each); `t` switches in the window, `p` switches preselection")
-      ->transform(program::one_of(techniques));
-  cmd->add_option("--click", args->clicks,
-                  "A scripted click: U,V@T (the mouse at pixel U,V at scene second T), target:NAME@T (NAME's "
-                  "two-step target) or pointer@T (the scene's tracked pointer); repeat for a session. Selections "
-                  "are told on stdout");
+  add_selection_options(*cmd, args->selection);
   cmd->callback([args] {
     if (const int code = run_ar(*args); code != 0) throw CLI::RuntimeError(code);
   });

@@ -20,7 +20,7 @@ constexpr double kScale = 1 << kShift;
 // picture can be checked pixel by pixel; labels are yellow, the legend's text light grey.
 const cv::Scalar kBlue(255, 120, 0), kGreen(0, 200, 0), kWhite(255, 255, 255),
     kGrey(160, 160, 160), kRed(0, 0, 255), kYellow(0, 230, 230), kLegend(210, 210, 210),
-    kPanel(30, 30, 30), kCyan(230, 200, 0), kMagenta(230, 0, 230);
+    kPanel(30, 30, 30), kCyan(230, 200, 0), kMagenta(230, 0, 230), kOrange(0, 150, 255);
 
 cv::Point fixed_point(const client::Vec2& p) {
   return {cvRound(p.x() * kScale), cvRound(p.y() * kScale)};
@@ -115,8 +115,10 @@ void draw_regions(cv::Mat& image, const RegionsReport& report, const WidgetFrame
   for (std::size_t i = 0; i < report.objects.size(); ++i) {
     const client::ObjectRegions& r = report.objects[i].regions;
     const bool selected = selecting && widgets->selection.selected == static_cast<int>(i);
+    const bool clicked = widgets && widgets->clicked == static_cast<int>(i);
     const bool bold = widgets && augmentation(i) == scene::Augmentation::outline;
-    draw_polygon(image, outline_of(r), selected ? kRed : bold ? kCyan : kGrey, selected || bold ? 2 : 1);
+    draw_polygon(image, outline_of(r), clicked ? kOrange : selected ? kRed : bold ? kCyan : kGrey,
+                 clicked ? 3 : selected || bold ? 2 : 1);
     draw_vertex_ellipses(image, r, scale);
     draw_polygon(image, r.outer, kGreen, 2);
     draw_polygon(image, r.inner, kWhite, 2);

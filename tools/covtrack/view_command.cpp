@@ -2,7 +2,8 @@
 // from the scene's fixed values, or from the daemon's streams (--live), or from a
 // recorded session at its own time (--log); tracked edges grow with report age, so
 // latency shows as error. Output: a window when a display exists, else one PNG (--png)
-// or a video (--video).
+// or a video (--video). In the window, or by scripted clicks, a user selects objects
+// (selection_input.hpp).
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -23,6 +24,7 @@
 #include "covtrack/program/command_line.hpp"
 #include "region_drawing.hpp"
 #include "regions_report.hpp"
+#include "selection_input.hpp"
 #include "stop_signal.hpp"
 #include "view_background.hpp"
 #include "view_clock.hpp"
@@ -39,6 +41,7 @@ struct ViewArgs {
   std::string scene_path;
   ViewSourceArgs source;
   ViewOutputArgs output;
+  SelectionArgs selection;
   client::ProjectionMethod method = client::ProjectionMethod::unscented;
 };
 
@@ -62,12 +65,27 @@ std::vector<std::string> legend_lines(const RegionsModel& model, const LatestRep
   return lines;
 }
 
-// What the pointer does now, for the legend.
-std::string selection_line(const RegionsReport& report, const WidgetFrame& w) {
+// The scene's tracked pointer on the screen with its error: none without one, unusable
+// (lost) when its transform is not known now.
+std::optional<client::Pointer> tracked_pointer(const RegionsModel& model, const RegionsReport& report) {
+  if (!model.scene.pointer) return std::nullopt;
+  if (!report.pointer_tip) return client::Pointer{client::Vec2::Zero(), {}, true};
+  return client::pointer_from_projection(*report.pointer_tip, report.confidence);
+}
+
+std::vector<client::Selectable> selectables_of(const RegionsReport& report) {
+  std::vector<client::Selectable> objects;
+  for (const RegionsReport::Object& o : report.objects) objects.push_back(client::selectable_of(o.regions));
+  return objects;
+}
+
+// What the pointer selects now, for the legend.
+std::string pointer_line(const RegionsReport& report, const WidgetFrame& w) {
   if (!w.pointer) return {};
   if (w.pointer->lost) return "pointer: no usable position, selects nothing";
   const auto& s = w.selection;
   const std::string head = "pointer (yellow p=0, red p=1): ";
+  if (!w.preselect) return head + "preselection off";
   if (!s.selected) return head + "selects nothing";
   const auto named = [&](int object) {
     const auto i = static_cast<std::size_t>(object);
@@ -81,6 +99,17 @@ std::string selection_line(const RegionsReport& report, const WidgetFrame& w) {
   for (std::size_t k = 0; k < std::min(kListed, s.candidates.size()); ++k) listed.push_back(named(s.candidates[k]));
   if (s.candidates.size() > kListed) listed.push_back("...");
   return head + fmt::format("pick a target of {}: {}", s.candidates.size(), fmt::join(listed, ", "));
+}
+
+// The legend's lines on selection: with a user, what was clicked; what the pointer selects.
+std::vector<std::string> selection_lines(const RegionsReport& report, const WidgetFrame& w) {
+  std::vector<std::string> lines;
+  if (!w.technique.empty()) {
+    const std::string clicked = w.clicked ? report.objects[static_cast<std::size_t>(*w.clicked)].name : "nothing";
+    lines.push_back(fmt::format("{} selection (t switches, p preselects): {} selected (orange)", w.technique, clicked));
+  }
+  if (std::string line = pointer_line(report, w); !line.empty()) lines.push_back(std::move(line));
+  return lines;
 }
 
 int run_view(const ViewArgs& args) {
@@ -97,6 +126,10 @@ int run_view(const ViewArgs& args) {
   if (!model) return fail_with(model.error().message, 2);
   auto widgets = ViewWidgets::create(model->scene);
   if (!widgets) return fail_with(fmt::format("{}: {}", args.scene_path, widgets.error().message), 2);
+  // A user selects in the window, or a script (--click) does.
+  auto input = SelectionInput::create(model->scene, model->camera, model->confidence, args.selection);
+  if (!input) return fail_with(input.error().message, program::kExitUsageError);
+  const bool with_user = window || !args.selection.clicks.empty();
 
   auto source = ViewSource::open(*model, args.source, "covtrack view");
   if (!source) return fail_with(source.error().message, source.error().exit_code);
@@ -112,7 +145,16 @@ int run_view(const ViewArgs& args) {
     if (!opened) return fail_with(opened.error().message, program::kExitRuntimeError);
     video.emplace(std::move(*opened));
   }
-  if (window) cv::namedWindow("covtrack view", cv::WINDOW_AUTOSIZE);
+  if (window) {
+    // GUI_NORMAL: no toolbar above the image (Qt's), so the image starts at the window's corner.
+    cv::namedWindow("covtrack view", cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);
+    // Called from cv::waitKey, on this thread; the window shows the image 1:1.
+    cv::setMouseCallback("covtrack view", [](int event, int x, int y, int, void* user) {
+      auto& in = *static_cast<SelectionInput*>(user);
+      if (event == cv::EVENT_MOUSEMOVE) in.move_mouse(client::Vec2(x, y));
+      else if (event == cv::EVENT_LBUTTONDOWN) in.press_mouse(client::Vec2(x, y));
+    }, &*input);
+  }
 
   install_stop_signals();
   src.announce();
@@ -126,8 +168,11 @@ int run_view(const ViewArgs& args) {
     const bool last = stop_requested() || (duration_s > 0 && elapsed_s >= duration_s - 1e-9) || src.finished();
     const auto report = compute_regions(*model, src.graph(), *now, args.method);
     if (!report) return fail_with(fmt::format("{}: {}", args.scene_path, report.error().message), 2);
-    // Every frame feeds the Level-of-Error hysteresis, even those --png does not write.
-    const WidgetFrame widget_frame = widgets->update(*report, size);
+    // Every frame feeds the Level-of-Error hysteresis and takes the clicks due, even
+    // those --png does not write.
+    std::optional<SelectionState> user;
+    if (with_user) user = input->frame(tracked_pointer(*model, *report), selectables_of(*report), elapsed_s, std::cout);
+    const WidgetFrame widget_frame = widgets->update(*report, size, user ? &*user : nullptr);
     // --png takes its one frame at the end of --duration (live streams have arrived by then).
     if (!args.output.png_path.empty() && !last && duration_s > 0) continue;
 
@@ -137,7 +182,7 @@ int run_view(const ViewArgs& args) {
       warning.clear();
     }
     auto lines = legend_lines(*model, src.latest_report(), src.mismatches(), *now);
-    if (const std::string line = selection_line(*report, widget_frame); !line.empty()) lines.push_back(line);
+    for (std::string& line : selection_lines(*report, widget_frame)) lines.push_back(std::move(line));
     draw_regions(image, *report, &widget_frame, legend_height_px(lines.size(), image.rows));
     draw_legend(image, lines);
 
@@ -151,6 +196,7 @@ int run_view(const ViewArgs& args) {
       cv::imshow("covtrack view", image);
       const int key = cv::waitKey(1);
       if (key == 'q' || key == 27 || cv::getWindowProperty("covtrack view", cv::WND_PROP_VISIBLE) < 1) break;
+      if (key >= 0) input->press_key(key & 0xff);
     }
     if (last) break;
   }
@@ -166,6 +212,7 @@ void add_view_command(CLI::App& app) {
   cmd->add_option("SCENE", args->scene_path, "Scene file (config/scene_schema.md)")->required();
   add_view_source_options(*cmd, args->source);
   add_view_output_options(*cmd, args->output, "q/Esc/Ctrl-C");
+  add_selection_options(*cmd, args->selection);
   const std::map<std::string, client::ProjectionMethod> methods = {
       {"unscented", client::ProjectionMethod::unscented}, {"linear", client::ProjectionMethod::linear}};
   cmd->add_option("--method", args->method, "Vertex projection: unscented or linear")

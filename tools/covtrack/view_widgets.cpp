@@ -24,23 +24,32 @@ ViewWidgets::ViewWidgets(std::vector<client::LevelOfError> levels, const scene::
   if (scene.pointer) likelihood_ = scene.pointer->likelihood;
 }
 
-WidgetFrame ViewWidgets::update(const RegionsReport& report, const cv::Size& screen) {
+WidgetFrame ViewWidgets::update(const RegionsReport& report, const cv::Size& screen, const SelectionState* user) {
   WidgetFrame frame;
   for (std::size_t i = 0; i < report.objects.size(); ++i) {
     const int level = levels_[i].update(report.objects[i].regions.assessment);
     frame.augmentations.push_back(augmentations_[i][static_cast<std::size_t>(level)]);
   }
-  if (!likelihood_ || !report.pointer_tip) return frame;
+  if (user) {
+    frame.clicked = user->selected;
+    frame.technique = user->technique_name;
+    frame.pointer = user->pointer;
+    frame.preselect = user->preselect;
+  } else if (likelihood_ && report.pointer_tip) {
+    frame.pointer = client::pointer_from_projection(*report.pointer_tip, report.confidence);
+  }
+  if (!frame.pointer) return frame;
 
-  frame.pointer = client::pointer_from_projection(*report.pointer_tip, report.confidence);
   // Objects are selected by their outer regions: where the object can be on the screen.
   std::vector<client::Selectable> selectables;
   for (const RegionsReport::Object& o : report.objects) selectables.push_back(client::selectable_of(o.regions));
-  frame.likelihoods = *likelihood_ == scene::Likelihood::area
-                          ? client::likelihoods_by_area(*frame.pointer, selectables)
-                          : client::likelihoods_by_distance(*frame.pointer, selectables);
-  frame.selection = client::select_direct(frame.likelihoods, selectables);
-  if (frame.selection.ambiguous()) {
+  frame.likelihoods = likelihood_ == scene::Likelihood::distance
+                          ? client::likelihoods_by_distance(*frame.pointer, selectables)
+                          : client::likelihoods_by_area(*frame.pointer, selectables);
+  if (frame.preselect) frame.selection = client::select_direct(frame.likelihoods, selectables);
+  if (user) {
+    frame.targets = user->targets;  // laid out by a click, waiting for the next
+  } else if (frame.selection.ambiguous()) {
     client::IndirectOptions options;
     options.screen = {client::Vec2(0, 0), client::Vec2(screen.width, screen.height)};
     // Wide enough for the longest candidate's name: a cut name cannot be told apart.

@@ -2,8 +2,11 @@
 // The adaptive widgets (docs/background.md) for each frame of `covtrack view`: every
 // object's Level-of-Error choice (5.6.2; its hysteresis needs the frames before, so this
 // object lives as long as the view) and, when the scene has a pointer, each object's
-// selection likelihood and the selection it makes (chapter 6).
+// selection likelihood and the selection it makes (chapter 6). In a session with a user
+// (a window, or scripted clicks: selection_input.hpp) the pointer may also be the mouse,
+// and clicks select.
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -13,6 +16,7 @@
 #include "covtrack/protocol/result.hpp"
 #include "covtrack/scene/scene.hpp"
 #include "regions_report.hpp"
+#include "selection_state.hpp"
 
 namespace covtrack::cli {
 
@@ -22,8 +26,12 @@ struct WidgetFrame {
   // candidates, the indirect targets (6.6.2) laid out above the pointer.
   std::optional<client::Pointer> pointer;
   std::vector<double> likelihoods;
-  client::DirectSelection selection;
+  client::DirectSelection selection;  // what the pointer selects now (preselection)
+  bool preselect = true;              // false: a user turned preselection off
   std::vector<client::SelectionTarget> targets;
+  // With a user: the object clicked, and the technique ("direct" or "two-step").
+  std::optional<int> clicked;
+  std::string technique;
 };
 
 class ViewWidgets {
@@ -31,7 +39,9 @@ class ViewWidgets {
   // Fails naming the object whose Level-of-Error thresholds are invalid.
   static Result<ViewWidgets> create(const scene::Scene& scene);
 
-  WidgetFrame update(const RegionsReport& report, const cv::Size& screen);
+  // `user`: this frame of a session with a user; its pointer and clicks replace the
+  // scene's pointer alone, and the targets shown are those its clicks laid out.
+  WidgetFrame update(const RegionsReport& report, const cv::Size& screen, const SelectionState* user = nullptr);
 
  private:
   ViewWidgets(std::vector<client::LevelOfError> levels, const scene::Scene& scene);
