@@ -9,7 +9,7 @@ packages=(build-essential cmake pkg-config liblcm-dev liblcm-bin libeigen3-dev
           libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev
           libgtest-dev libgmock-dev libbenchmark-dev libopencv-core-dev libopencv-imgproc-dev
           libopencv-calib3d-dev libopencv-imgcodecs-dev libopencv-videoio-dev libopencv-highgui-dev
-          libapriltag-dev libqhull-dev libserial-dev libusb-1.0-0-dev libhidapi-dev xvfb xauth
+          libapriltag-dev libqhull-dev libserial-dev libusb-1.0-0-dev libhidapi-dev libsodium-dev xvfb xauth
           xdotool  # the window tests move the mouse and press keys
           iproute2 util-linux python3-dev pybind11-dev python3-numpy python3-pytest
           default-jdk-headless liblcm-java libjchart2d-java

@@ -10,12 +10,16 @@
 #include <thread>
 #include <unordered_map>
 
+#include <fmt/format.h>
+
 #include "covtrack/client/pose_validation.hpp"
 #include "covtrack/client/sequence_tracker.hpp"
 #include "covtrack/protocol/channel_messages.hpp"
 #include "covtrack/protocol/channel_pattern.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
+#include "covtrack/protocol/message_auth.hpp"
+#include "covtrack/protocol/replay_guard.hpp"
 #include "udpm_receiver.hpp"
 
 namespace covtrack::client {
@@ -28,6 +32,8 @@ constexpr std::int64_t kDrainUs = 200'000;
 constexpr int kStatusQueueCapacity = 1000;
 // Batches of datagrams read per wake-up before the clock is checked for silence.
 constexpr int kBatchesPerWake = 16;
+// The largest SubscriberOptions::auth_max_age_s: a day is no protection against replays already.
+constexpr double kMaxAuthAgeS = 86400;
 // Channels whose verdict is remembered; the bus has few, a flood of made-up ones resets it.
 constexpr std::size_t kChannelVerdicts = 4096;
 
@@ -58,7 +64,7 @@ struct Subscriber::Impl final : UdpmReceiver::Handler {
   int wake_fd = -1;
   std::jthread thread;
 
-  mutable std::mutex mutex;  // guards streams, devices and rejections
+  mutable std::mutex mutex;  // guards streams, devices, rejections and auth
   struct Stream {
     explicit Stream(std::int64_t window) : sequence(window) {}
     StreamState state;
@@ -72,6 +78,9 @@ struct Subscriber::Impl final : UdpmReceiver::Handler {
   std::map<std::string, Stream> streams;  // by "device/sensor"
   std::map<std::string, DeviceTracker> devices;  // by device name
   RejectionTally rejections;  // every rejected message, of any channel
+  std::optional<AuthKey> key;
+  std::optional<ReplayGuard> replay_guard;  // with a key; the dispatch thread's only
+  AuthCounters auth;
 
   std::mutex callbacks_mutex;
   std::shared_ptr<const CallbackList> callbacks = std::make_shared<CallbackList>();
@@ -97,11 +106,34 @@ struct Subscriber::Impl final : UdpmReceiver::Handler {
     rejections.add(to_string(why.fault), channel, why.describe());
   }
 
+  // The message without its trailer when it needs none (no key) or is authentic and
+  // fresh; nothing, counted, otherwise.
+  std::optional<std::span<const std::byte>> authentic(std::string_view channel, std::span<const std::byte> bytes) {
+    if (!key) return bytes;
+    const auto checked = authenticate(*key, channel, bytes);
+    const auto replay = checked ? replay_guard->check(channel, checked->trailer, now_us()) : std::nullopt;
+    std::lock_guard lock(mutex);
+    if (!checked) {
+      ++(checked.error() == AuthFault::Missing ? auth.unauthenticated : auth.forged);
+      rejections.add(to_string(checked.error()), std::string(channel),
+                     checked.error() == AuthFault::Missing ? "no authentication trailer"
+                                                           : "the MAC does not match (another key, or altered bytes)");
+      return std::nullopt;
+    }
+    if (replay) {
+      ++auth.replayed;
+      rejections.add("replayed", std::string(channel), *replay);
+      return std::nullopt;
+    }
+    ++auth.authenticated;
+    return checked->message;
+  }
+
   void on_pose_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-    on_pose(channel, bytes_of(rbuf->data, rbuf->data_size));
+    if (auto bytes = authentic(channel, bytes_of(rbuf->data, rbuf->data_size))) on_pose(channel, *bytes);
   }
   void on_status_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-    on_status(channel, bytes_of(rbuf->data, rbuf->data_size));
+    if (auto bytes = authentic(channel, bytes_of(rbuf->data, rbuf->data_size))) on_status(channel, *bytes);
   }
 
   // UdpmReceiver::Handler: the channels LCM's subscriptions would let in (below, attach()).
@@ -117,10 +149,12 @@ struct Subscriber::Impl final : UdpmReceiver::Handler {
     return wanted;
   }
   void on_message(std::string_view channel, std::span<const std::byte> payload) override {
+    const auto bytes = authentic(channel, payload);
+    if (!bytes) return;
     if (channel.starts_with(kPosePrefix))
-      on_pose(channel, payload);
+      on_pose(channel, *bytes);
     else
-      on_status(channel, payload);
+      on_status(channel, *bytes);
   }
   void on_malformed(const std::string& from, const lcm_wire::DatagramRejection& why) override {
     std::lock_guard lock(mutex);
@@ -303,6 +337,19 @@ Result<std::unique_ptr<Subscriber>> Subscriber::attach(std::shared_ptr<lcm::LCM>
 }
 
 Result<std::unique_ptr<Subscriber>> Subscriber::start(std::unique_ptr<Impl> impl) {
+  if (const std::string key_file = effective_key_file(impl->options.key_file); !key_file.empty()) {
+    auto key = load_auth_key(key_file);
+    const double max_age_s = impl->options.auth_max_age_s;
+    if (!key || !(max_age_s > 0 && max_age_s <= kMaxAuthAgeS)) {  // also refuses NaN
+      impl->unsubscribe();
+      return key ? fail(fmt::format("Subscriber: auth_max_age_s must be above 0 and at most {} s, got {}",
+                                    kMaxAuthAgeS, max_age_s))
+                 : std::unexpected(key.error());
+    }
+    impl->key = *key;
+    impl->replay_guard.emplace(impl->options.auth_max_age_s);
+    impl->auth.key_file = key_file;
+  }
   impl->wake_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
   if (impl->wake_fd < 0) {
     impl->unsubscribe();
@@ -362,6 +409,12 @@ std::map<std::string, DeviceState> Subscriber::devices() const {
 RejectionTally Subscriber::rejections() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->rejections;
+}
+
+std::optional<AuthCounters> Subscriber::authentication() const {
+  std::lock_guard lock(impl_->mutex);
+  if (!impl_->key) return std::nullopt;
+  return impl_->auth;
 }
 
 void Subscriber::stop() {

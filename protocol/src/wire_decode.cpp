@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "covtrack/protocol/channels.hpp"
+#include "covtrack/protocol/message_auth.hpp"
 #include "covtrack/protocol/wire_text.hpp"
 #include "wire_layout.hpp"
 
@@ -98,7 +99,9 @@ std::expected<void, WireRejection> check_string(const Field& f, std::span<const 
 }
 
 // Walks the fields as lcm-gen encodes them; every length is checked against what is left.
-std::expected<void, WireRejection> walk(const wire::Layout& layout, std::span<const std::byte> bytes) {
+// Returns where the message ends: the size of the bytes, or where an authentication
+// trailer (message_auth.hpp) after the last field starts.
+std::expected<std::size_t, WireRejection> walk(const wire::Layout& layout, std::span<const std::byte> bytes) {
   Cursor c(bytes);
   if (c.left() < 8)
     return reject(WireFault::Truncated, fmt::format("{} bytes: shorter than the 8-byte type fingerprint", bytes.size()));
@@ -133,10 +136,10 @@ std::expected<void, WireRejection> walk(const wire::Layout& layout, std::span<co
       else c.skip(size);
     }
   }
-  if (c.left() > 0)
+  if (c.left() > 0 && !is_auth_trailer(bytes.subspan(c.offset())))
     return reject(WireFault::TrailingBytes, fmt::format("{} bytes after the last field of {} (at byte {})", c.left(),
                                                         layout.type, c.offset()));
-  return {};
+  return c.offset();
 }
 
 }  // namespace
@@ -145,9 +148,10 @@ template <typename Msg>
 Decoded<Msg> decode_message(std::span<const std::byte> bytes) {
   if (bytes.size() > static_cast<std::size_t>(INT_MAX))
     return reject(WireFault::BadLength, fmt::format("{} bytes: more than LCM's decoder takes", bytes.size()));
-  if (auto walked = walk(wire::layout_of<Msg>(), bytes); !walked) return std::unexpected(walked.error());
+  const auto walked = walk(wire::layout_of<Msg>(), bytes);
+  if (!walked) return std::unexpected(walked.error());
   Msg msg;
-  const int size = static_cast<int>(bytes.size());
+  const int size = static_cast<int>(*walked);
   try {  // the walk leaves nothing for it to throw on; this is the second line of defence
     if (const int n = msg.decode(bytes.data(), 0, size); n != size)
       return reject(WireFault::DecoderFailed, fmt::format("LCM's decoder returned {} for {} bytes", n, size));

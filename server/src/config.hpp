@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "covtrack/protocol/message_auth.hpp"
 #include "covtrack/protocol/result.hpp"
 #include "driver_table.hpp"
 #include "vrpn_server_config.hpp"
@@ -33,6 +34,7 @@ struct DaemonConfig {
   DaemonSettings daemon;
   std::vector<DeviceConfig> devices;  // enabled devices only
   std::optional<VrpnServerConfig> vrpn_server;
+  std::optional<AuthKey> auth_key;  // [auth]: sign every message (docs/authentication.md)
 };
 
 // What a config load checks beyond the config itself.

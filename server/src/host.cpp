@@ -7,8 +7,18 @@
 #include "covtrack/devices/interruptible_sleep.hpp"
 
 namespace covtrack::server {
+namespace {
 
-Host::Host(const DaemonConfig& config, lcm::LCM& lcm) : settings_(config.daemon), publisher_(lcm) {
+std::optional<MessageSigner> signer_of(const DaemonConfig& config, const PublisherIdentity& identity) {
+  if (!config.auth_key) return std::nullopt;
+  return MessageSigner(*config.auth_key, static_cast<std::uint64_t>(identity.instance_id));
+}
+
+}  // namespace
+
+// identity_ is initialised before publisher_: the signer names the same instance as the heartbeats.
+Host::Host(const DaemonConfig& config, lcm::LCM& lcm)
+    : settings_(config.daemon), publisher_(lcm, signer_of(config, identity_)) {
   for (const auto& device : config.devices)
     runners_.push_back(std::make_unique<DeviceRunner>(device, publisher_, settings_));
 }

@@ -131,7 +131,8 @@ int main(int argc, char** argv) {
     return kExitRuntimeError;
   }
   host.start(not_started);
-  spdlog::info("covtrackd: {} device(s) publishing on {}", names.size() - not_started.size(), url);
+  spdlog::info("covtrackd: {} device(s) publishing on {}{}", names.size() - not_started.size(), url,
+               config->auth_key ? ", every message authenticated ([auth])" : "");
 
   const int signal = covtrack::server::wait_for_stop_signal(stop_signals);
   if (signal == covtrack::server::kNothingLeftSignal)

@@ -24,8 +24,9 @@ bool Publisher::send(const std::string& channel, const Msg& msg) {
   const int size = msg.getEncodedSize();
   buffer_.resize(static_cast<std::size_t>(size));
   if (msg.encode(buffer_.data(), 0, size) != size) return false;
+  if (signer_) signer_->sign(channel, buffer_);
   errno = 0;
-  const bool sent = lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(size)) == 0;
+  const bool sent = lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(buffer_.size())) == 0;
   log_send_outcome(sent, channel, errno);
   return sent;
 }

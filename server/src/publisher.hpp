@@ -1,11 +1,13 @@
 #pragma once
 // The daemon's single LCM publisher. Drivers reach it through their DeviceSink; it
 // stamps publish time and the per-stream sequence numbers, which survive driver restarts
-// so that a client sees a gap only when a message was really lost.
+// so that a client sees a gap only when a message was really lost. With a key, it signs
+// every message (message_auth.hpp).
 #include <chrono>
 #include <cstdint>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <unordered_map>
 
@@ -14,12 +16,14 @@
 #include <covtrack/device_status_t.hpp>
 
 #include "covtrack/devices/driver.hpp"
+#include "covtrack/protocol/message_auth.hpp"
 
 namespace covtrack::server {
 
 class Publisher {
  public:
-  explicit Publisher(lcm::LCM& lcm) : lcm_(lcm) {}
+  explicit Publisher(lcm::LCM& lcm, std::optional<MessageSigner> signer = std::nullopt)
+      : lcm_(lcm), signer_(std::move(signer)) {}
 
   // Sees every pose after it is published (the VRPN server). Set before the devices
   // start; it runs on the device's thread, so it must not block.
@@ -44,6 +48,7 @@ class Publisher {
   void log_send_outcome(bool sent, const std::string& channel, int error);
 
   lcm::LCM& lcm_;
+  std::optional<MessageSigner> signer_;  // under mutex_, which orders its counter as the sends
   PoseTap tap_;
   std::mutex mutex_;  // LCM's publish is thread-safe; this guards the counters and buffer
   std::unordered_map<std::string, std::int64_t> sequences_;

@@ -1,6 +1,8 @@
 #pragma once
 // Valid pose messages for the client tests and benchmarks.
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include <covtrack/pose_cov_t.hpp>
 
@@ -37,6 +39,14 @@ inline pose_cov_t pose_message(const std::string& device, const std::string& sen
   m.status = pose_cov_t::STATUS_OK;
   set_pose(m, test_pose(), test_covariance());
   return m;
+}
+
+// The message as LCM encodes it (what a publisher sends, before any trailer).
+template <typename Msg>
+std::vector<std::uint8_t> encoded(const Msg& m) {
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(out.data(), 0, static_cast<int>(out.size()));
+  return out;
 }
 
 }  // namespace covtrack::test

@@ -1,6 +1,7 @@
 // The subscriber in one process over LCM's memq:// transport: the test publishes on the
 // instance the Subscriber is attached to (memq reaches only its own instance).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -14,6 +15,7 @@
 #include "covtrack/client/subscriber.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/covariance_conventions.hpp"
+#include "covtrack/protocol/message_auth.hpp"
 #include "pose_messages.hpp"
 
 using namespace covtrack;
@@ -369,4 +371,57 @@ TEST(Subscriber, BadUrlAndBadPatternFailAtOnce) {
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("not a multicast group"), std::string::npos);
   EXPECT_FALSE(client::Subscriber::attach(nullptr, {}));
+}
+
+// Through an lcm::LCM instance (memq), as over udpm: with a key, signed messages are
+// delivered, and unsigned, forged and repeated ones are counted and never reach a stream.
+TEST_F(SubscriberTest, WithAKeyOnlyAuthenticFreshMessagesAreDelivered) {
+  const std::string key_file = ::testing::TempDir() + "/subscriber_test_" + std::to_string(::getpid()) + ".key";
+  ::unlink(key_file.c_str());
+  ASSERT_TRUE(write_new_auth_key(key_file));
+  open({.key_file = key_file});
+  const auto key = load_auth_key(key_file);
+  ASSERT_TRUE(key);
+  MessageSigner signer(*key, 5);
+  const std::string channel = pose_channel("dev", "s");
+  auto publish_bytes = [&](const pose_cov_t& m, bool sign) {
+    auto bytes = test::encoded(m);
+    if (sign) signer.sign(channel, bytes);
+    lcm_->publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+    return bytes;
+  };
+  publish_bytes(pose_message("dev", "s", 0), true);
+  const auto second = publish_bytes(pose_message("dev", "s", 1), true);
+  publish_bytes(pose_message("dev", "s", 2), false);                          // unauthenticated
+  auto forged = second;
+  forged[40] ^= 1;
+  lcm_->publish(channel, forged.data(), static_cast<unsigned>(forged.size()));  // forged
+  lcm_->publish(channel, second.data(), static_cast<unsigned>(second.size()));  // replayed
+  publish_bytes(pose_message("dev", "s", 2), true);
+  ASSERT_TRUE(eventually([&] { return received("dev", "s") == 3; }));
+  const auto auth = sub_->authentication();
+  ASSERT_TRUE(auth);
+  EXPECT_EQ(auth->authenticated, 3);
+  EXPECT_EQ(auth->unauthenticated, 1);
+  EXPECT_EQ(auth->forged, 1);
+  EXPECT_EQ(auth->replayed, 1);
+  EXPECT_EQ(counters("dev", "s").rejected, 0);
+  EXPECT_EQ(counters("dev", "s").foreign, 0);
+  EXPECT_EQ(sub_->rejections().total, 3);
+}
+
+TEST_F(SubscriberTest, AnUnusableKeyFileOrMaxAgeIsRefusedAtOpen) {
+  const std::string key_file = ::testing::TempDir() + "/subscriber_test_age_" + std::to_string(::getpid()) + ".key";
+  ::unlink(key_file.c_str());
+  ASSERT_TRUE(write_new_auth_key(key_file));
+  sub_.reset();
+  for (double age : {0.0, -1.0, std::numeric_limits<double>::infinity(), std::nan("")}) {
+    auto s = client::Subscriber::attach(lcm_, {.key_file = key_file, .auth_max_age_s = age});
+    ASSERT_FALSE(s) << age;
+    EXPECT_NE(s.error().message.find("auth_max_age_s"), std::string::npos) << s.error().message;
+  }
+  auto missing = client::Subscriber::attach(lcm_, {.key_file = key_file + ".absent"});
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().message.find("No such file"), std::string::npos) << missing.error().message;
+  EXPECT_TRUE(client::Subscriber::attach(lcm_, {.key_file = key_file}));
 }

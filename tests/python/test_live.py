@@ -173,3 +173,26 @@ def test_the_example_script_prints_the_streams(daemon, source_dir):
     assert "optical/head" in run.stdout and "optical/wand" in run.stdout
     assert "magnetic" not in run.stdout
     assert " mm " in run.stdout and "reports" in run.stdout
+
+
+def test_authenticated_daemon_and_keyed_and_plain_subscribers(covtrackd, covtrack_cli, config, tmp_path):
+    key = tmp_path / "key"
+    subprocess.run([str(covtrack_cli), "keygen", str(key)], check=True, capture_output=True)
+    signed = tmp_path / "signed.toml"
+    signed.write_text(f'[auth]\nkey_file = "{key}"\n\n' + config[0].read_text())
+    process = subprocess.Popen([str(covtrackd), "--config", str(signed)], stdout=subprocess.DEVNULL)
+    try:
+        with covtrack.Subscriber(key_file=str(key)) as keyed, covtrack.Subscriber() as plain:
+            assert plain.authentication() is None
+            assert keyed.wait_for("optical", "head", timeout_s=WAIT_S) is not None
+            assert plain.wait_for("optical", "head", timeout_s=WAIT_S) is not None
+            counts = keyed.authentication()
+            assert counts["authenticated"] > 0
+            assert (counts["unauthenticated"], counts["forged"], counts["replayed"]) == (0, 0, 0)
+            assert plain.rejections() == {} and keyed.rejections() == {}
+        key.chmod(0o644)
+        with pytest.raises(RuntimeError, match="others may read"):
+            covtrack.Subscriber(key_file=str(key))
+    finally:
+        process.send_signal(signal.SIGTERM)
+        process.wait(timeout=10)

@@ -288,3 +288,32 @@ TEST(Config, DaemonExitsWithCode2AndStartsNothing) {
   expect_has(out, path + ":7:");
   EXPECT_EQ(out.find("publishing"), std::string::npos) << out;
 }
+
+// [auth]: the key is read with the config, relative to it; a key file others can read,
+// or a missing one, is an error at its key, and nothing starts.
+TEST(Config, AuthKeyFileIsReadRelativeToTheConfigAndMustBeSecret) {
+  const std::string dir = ::testing::TempDir() + "/config_auth_" + std::to_string(::getpid());
+  ::mkdir(dir.c_str(), 0700);
+  const std::string key = dir + "/lab.key";
+  ::unlink(key.c_str());
+  ASSERT_TRUE(covtrack::write_new_auth_key(key));
+  const std::string config = dir + "/daemon.toml";
+  const std::string text = std::string(kGoodDevice) + "\n[auth]\nkey_file = \"lab.key\"\n";
+  auto good = parse_config(text, config);
+  ASSERT_TRUE(good) << good.error().message;
+  ASSERT_TRUE(good->auth_key);
+  EXPECT_EQ(good->auth_key->bytes, covtrack::load_auth_key(key)->bytes);
+  EXPECT_FALSE(parse_config(kGoodDevice, config)->auth_key) << "off by default";
+
+  ::chmod(key.c_str(), 0604);
+  auto readable = parse_config(text, config);
+  ASSERT_FALSE(readable);
+  EXPECT_NE(readable.error().message.find(config + ":9:12: auth.key_file: key file " + key + ": others may read"),
+            std::string::npos)
+      << readable.error().message;
+  auto missing = parse_config(std::string(kGoodDevice) + "\n[auth]\nkey_file = \"absent.key\"\n", config);
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().message.find("auth.key_file: key file " + dir + "/absent.key: No such file"),
+            std::string::npos)
+      << missing.error().message;
+}

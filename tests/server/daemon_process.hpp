@@ -34,7 +34,10 @@ class DaemonProcess {
     }
   }
   // covtrackd with exactly these arguments; its stdout and stderr go to `output_path`.
-  DaemonProcess(const std::vector<std::string>& args, const std::string& output_path) {
+  DaemonProcess(const std::vector<std::string>& args, const std::string& output_path)
+      : DaemonProcess(COVTRACK_BINARY_DIR "/server/covtrackd", args, output_path) {}
+  // Another program the same way (`covtrack echo`, ...).
+  DaemonProcess(const std::string& exe, const std::vector<std::string>& args, const std::string& output_path) {
     pid_ = fork();
     if (pid_ == 0) {
       const int out = ::open(output_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -42,7 +45,6 @@ class DaemonProcess {
         dup2(out, STDOUT_FILENO);
         dup2(out, STDERR_FILENO);
       }
-      const std::string exe = COVTRACK_BINARY_DIR "/server/covtrackd";
       std::vector<char*> argv{const_cast<char*>(exe.c_str())};
       for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
       argv.push_back(nullptr);

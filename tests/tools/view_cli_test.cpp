@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
+#include "golden_image.hpp"
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -195,23 +196,10 @@ TEST(ViewCli, ToolBoxFrameMatchesTheGoldenImage) {
   const std::string png = (kTmp / "covtrack_view_toolbox.png").string();
   const CliRun view = run("view " COVTRACK_SOURCE_DIR "/config/scenes/toolbox.toml --png " + png + " --duration 4.5");
   ASSERT_EQ(view.exit_code, 0) << view.out;
-  const cv::Mat image = cv::imread(png, cv::IMREAD_COLOR);
-  ASSERT_FALSE(image.empty());
-  if (std::getenv("COVTRACK_UPDATE_GOLDEN")) std::filesystem::copy_file(png, golden, std::filesystem::copy_options::overwrite_existing);
-  const cv::Mat expected = cv::imread(golden, cv::IMREAD_COLOR);
-  ASSERT_FALSE(expected.empty()) << golden;
-  ASSERT_EQ(image.size(), expected.size());
-  cv::Mat difference;
-  cv::absdiff(image, expected, difference);
-  int differing = 0;
-  for (int y = 0; y < difference.rows; ++y)
-    for (int x = 0; x < difference.cols; ++x) {
-      const cv::Vec3b d = difference.at<cv::Vec3b>(y, x);
-      differing += std::max({d[0], d[1], d[2]}) > 48;
-    }
-  const double fraction = double(differing) / (image.rows * image.cols);
-  std::printf("golden: %d pixels (%.3f%%) differ by more than 48 levels\n", differing, 100 * fraction);
-  EXPECT_LT(fraction, 0.002);
+  const auto fraction = golden_difference(png, golden);
+  ASSERT_TRUE(fraction) << "cannot compare " << png << " with " << golden;
+  std::printf("golden: %.3f%% of the pixels differ by more than 48 levels\n", 100 * *fraction);
+  EXPECT_LT(*fraction, 0.002);
   std::filesystem::remove(png);
 }
 

@@ -12,6 +12,7 @@ void add_view_command(CLI::App& app);
 void add_emulate_lenz_command(CLI::App& app);
 void add_emulate_6dof_command(CLI::App& app);
 void add_devices_command(CLI::App& app);
+void add_keygen_command(CLI::App& app);
 void add_render_tags_command(CLI::App& app);
 void add_calibrate_fiducial_command(CLI::App& app);
 void add_ar_command(CLI::App& app);

@@ -143,6 +143,7 @@ std::string table(const client::Subscriber& sub, RateMeter& rates) {
          "position / rotation block, BODY frame); foreign: messages off the stream's sequence "
          "(a second publisher, forged, duplicate); restart: the sequence started again; stale "
          "times: how often it went stale\n";
+  out += authentication_line(sub);
   if (const RejectionTally rejected = sub.rejections(); rejected.total > 0)
     out += "rejected messages: " + rejected.summary() + "\n";
   for (const auto& [name, device] : sub.devices()) out += device_line(name, device);
@@ -158,8 +159,10 @@ int run_echo(const EchoOptions& o) {
     return 1;
   }
   // Scripts and tests wait for this line: from here on every message is seen.
-  std::cerr << fmt::format("covtrack echo: listening on {} for streams '{}' (Ctrl-C ends)\n",
-                           effective_lcm_url(o.subscriber.lcm_url), o.subscriber.pattern);
+  const auto auth = (*sub)->authentication();
+  std::cerr << fmt::format("covtrack echo: listening on {} for streams '{}'{} (Ctrl-C ends)\n",
+                           effective_lcm_url(o.subscriber.lcm_url), o.subscriber.pattern,
+                           auth ? ", authenticated messages only (key " + auth->key_file + ")" : "");
   std::cerr << receive_buffer_warning(**sub, "covtrack echo: ");
   std::atomic<long> seen{0};
   // Runs on the subscriber's dispatch thread, the only writer of stdout in --json mode.
@@ -189,7 +192,7 @@ int run_echo(const EchoOptions& o) {
     if (o.duration_s > 0 && now - start >= std::chrono::duration<double>(o.duration_s)) break;
     if (!hinted && now >= hint_at) {
       hinted = true;
-      if ((*sub)->streams().empty() && (*sub)->devices().empty())
+      if ((*sub)->streams().empty() && (*sub)->devices().empty() && (*sub)->rejections().total == 0)
         std::cerr << fmt::format("covtrack echo: nothing received for {} s on {} (streams '{}'): is covtrackd "
                                  "running and publishing there? (covtrackd --config config/sim.toml); still waiting, Ctrl-C ends\n",
                                  kSilenceHint.count(), effective_lcm_url(o.subscriber.lcm_url),
@@ -215,6 +218,7 @@ void add_echo_command(CLI::App& app) {
                   "POSIX extended regular expression over device/sensor, whole match (default: all)");
   cmd->add_flag("--json,-j", o->json, "one JSON object per message, one per line");
   cmd->add_option("--lcm-url,-u", o->subscriber.lcm_url, "LCM URL");
+  add_key_file_option(*cmd, o->subscriber.key_file);
   cmd->add_option("--stale", o->subscriber.stale_after_s, "seconds without a message before a stream is stale")
       ->check(program::positive());
   cmd->add_option("--count,-n", o->count, "exit after this many accepted messages")->check(program::non_negative());

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   covtrack::cli::add_emulate_lenz_command(app);
   covtrack::cli::add_emulate_6dof_command(app);
   covtrack::cli::add_devices_command(app);
+  covtrack::cli::add_keygen_command(app);
   covtrack::program::add_conventions(app);
   return covtrack::program::parse_command_line(app, argc, argv).value_or(covtrack::program::kExitOk);
 }

@@ -9,6 +9,7 @@
 #include <fmt/ranges.h>
 
 #include "covtrack/program/command_line.hpp"
+#include "view_labels.hpp"
 
 namespace covtrack::cli {
 namespace {
@@ -73,6 +74,10 @@ Result<SelectionInput> SelectionInput::create(const scene::Scene& scene, const c
   std::stable_sort(script.begin(), script.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
   client::TwoStepSelection::Options options;
   options.indirect.screen = {client::Vec2(0, 0), client::Vec2(camera.width_px, camera.height_px)};
+  // Targets wide enough for the longest name, at the labels' font: a cut name cannot be
+  // told apart from another.
+  for (const scene::SceneObject& o : scene.objects)
+    options.indirect.target_size_px.x() = std::max(options.indirect.target_size_px.x(), label_box_px(o.name).x());
   return SelectionInput(scene, confidence, client::SelectionSession(options, args.technique), std::move(script));
 }
 

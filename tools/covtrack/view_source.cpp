@@ -15,6 +15,7 @@ namespace covtrack::cli {
 void add_view_source_options(CLI::App& command, ViewSourceArgs& args) {
   command.add_flag("--live", args.live, "Tracked transforms from the daemon's streams, not the scene's values");
   command.add_option("--lcm-url,-u", args.lcm_url, "LCM URL for --live (default: $LCM_DEFAULT_URL or LCM's)");
+  add_key_file_option(command, args.key_file);
   command.add_option("--log", args.log_path, "Follow a recorded session (LCM log) at its own time");
   command.add_option("--speed,-s", args.speed, "Speed factor of --log")
       ->capture_default_str()
@@ -32,7 +33,7 @@ std::expected<std::unique_ptr<ViewSource>, ViewSourceError> ViewSource::open(con
   if (auto r = scene::add_scene_transforms(model.scene, s->graph_, s->fixed_at_); !r)
     return error(fmt::format("{}: {}", model.scene_path, r.error().message), 2);
   if (args.live) {
-    auto sub = client::Subscriber::open({.lcm_url = args.lcm_url});
+    auto sub = client::Subscriber::open({.lcm_url = args.lcm_url, .key_file = args.key_file});
     if (!sub) return error(sub.error().message, program::kExitRuntimeError);
     s->subscriber_ = std::move(*sub);
     std::cerr << receive_buffer_warning(*s->subscriber_, s->command_ + ": ");

@@ -24,11 +24,12 @@ namespace covtrack::cli {
 struct ViewSourceArgs {
   bool live = false;
   std::string lcm_url;
+  std::string key_file;  // --live: SubscriberOptions::key_file
   std::string log_path;
   double speed = 1;  // of the log's clock
 };
 
-// --live, --lcm-url, --log and --speed on a view's subcommand.
+// --live, --lcm-url, --key-file, --log and --speed on a view's subcommand.
 void add_view_source_options(CLI::App& command, ViewSourceArgs& args);
 
 struct ViewSourceError {

@@ -82,6 +82,12 @@ void add_lines(osg::Geometry& g, GLenum mode, std::span<const client::Vec2> poin
   g.addPrimitiveSet(new osg::DrawArrays(mode, first, static_cast<GLsizei>(points.size())));
 }
 
+void in_bin(osg::Object& node_or_drawable, int bin, const char* kind, osg::StateSet::RenderBinMode mode) {
+  osg::StateSet* state = node_or_drawable.asNode() ? node_or_drawable.asNode()->getOrCreateStateSet()
+                                                   : static_cast<osg::Drawable&>(node_or_drawable).getOrCreateStateSet();
+  state->setRenderBinDetails(bin, kind, mode);
+}
+
 void finish_lines(osg::Geometry& g) {
   g.getVertexArray()->dirty();
   g.dirtyBound();
@@ -188,11 +194,22 @@ void ArScene::build_overlay() {
   selected_lines_ = line_geometry(options_.selected_colour);
   preselected_lines_ = line_geometry(options_.preselected_colour);
   pointer_lines_ = line_geometry(options_.pointer_colour);
+  target_panels_ = line_geometry(options_.target_panel_colour);
+  target_lines_ = line_geometry(options_.pointer_colour);
   osg::ref_ptr<osg::Geode> lines = new osg::Geode;
   for (osg::Geometry* g : overlay_lines()) lines->addDrawable(g);
   labels_ = new osg::Geode;
+  target_labels_ = new osg::Geode;
+  // Drawing order by render bin: the lines (0), the objects' labels (1), the two-step
+  // targets' panels (2) and outlines (3), their names (4). Text asks for the transparent
+  // bin itself: the labels' bins override that.
+  in_bin(*labels_, 1, "DepthSortedBin", osg::StateSet::OVERRIDE_RENDERBIN_DETAILS);
+  in_bin(*target_panels_, 2, "RenderBin", osg::StateSet::USE_RENDERBIN_DETAILS);
+  in_bin(*target_lines_, 3, "RenderBin", osg::StateSet::USE_RENDERBIN_DETAILS);
+  in_bin(*target_labels_, 4, "DepthSortedBin", osg::StateSet::OVERRIDE_RENDERBIN_DETAILS);
   overlay_->addChild(lines);
   overlay_->addChild(labels_);
+  overlay_->addChild(target_labels_);
   root_->addChild(overlay_);
 }
 
@@ -273,9 +290,10 @@ void ArScene::update(const client::ArFrame& frame, std::span<const std::string> 
   for (osg::Geometry* g : overlay_lines()) finish_lines(*g);
 }
 
-std::array<osg::Geometry*, 5> ArScene::overlay_lines() const {
-  // In drawing order: a selection's outlines over the regions.
-  return {outer_lines_.get(), inner_lines_.get(), preselected_lines_.get(), selected_lines_.get(), pointer_lines_.get()};
+std::array<osg::Geometry*, 7> ArScene::overlay_lines() const {
+  // In drawing order: a selection's outlines over the regions, its targets over all.
+  return {outer_lines_.get(),   inner_lines_.get(),   preselected_lines_.get(), selected_lines_.get(),
+          pointer_lines_.get(), target_panels_.get(), target_lines_.get()};
 }
 
 void ArScene::draw_selection(const client::ArFrame& frame, const SelectionDrawing& selection) {
@@ -288,10 +306,12 @@ void ArScene::draw_selection(const client::ArFrame& frame, const SelectionDrawin
   add_lines(*pointer_lines_, GL_LINE_LOOP, selection.pointer_region);
   for (std::size_t k = 0; k < selection.targets.size(); ++k) {
     const client::Box& box = selection.targets[k].box;
-    add_lines(*pointer_lines_, GL_LINE_LOOP, client::box_polygon(box));
+    const client::Polygon corners = client::box_polygon(box);
+    add_lines(*target_panels_, GL_TRIANGLE_FAN, corners);
+    add_lines(*target_lines_, GL_LINE_LOOP, corners);
     if (k >= target_texts_.size()) {
       target_texts_.push_back(overlay_text(options_.pointer_colour));
-      labels_->addDrawable(target_texts_.back());
+      target_labels_->addDrawable(target_texts_.back());
     }
     if (k < selection.target_names.size()) put_text(*target_texts_[k], selection.target_names[k], box);
   }

@@ -81,7 +81,8 @@ std::set<PySubscriber*> open_subscribers;  // closed at interpreter exit
 
 class PySubscriber {
  public:
-  PySubscriber(const std::optional<std::string>& lcm_url, const std::string& streams, double stale_after_s) {
+  PySubscriber(const std::optional<std::string>& lcm_url, const std::string& streams, double stale_after_s,
+               const std::optional<std::string>& key_file) {
     if (auto pattern = compile_channel_pattern(streams); !pattern)
       throw py::value_error("streams: " + pattern.error().message);
     if (!(stale_after_s > 0)) throw py::value_error("stale_after_s must be positive");
@@ -89,6 +90,7 @@ class PySubscriber {
     options.lcm_url = lcm_url.value_or("");
     options.pattern = streams;
     options.stale_after_s = stale_after_s;
+    options.key_file = key_file.value_or("");
     sub_ = value_or_raise<std::runtime_error>(Subscriber::open(options));
     (void)sub_->on_pose(".*", [arrivals = arrivals_](const TrackedTransform& t) { arrivals->note(t.stream.key()); });
     std::lock_guard lock(open_mutex);
@@ -160,6 +162,14 @@ class PySubscriber {
   std::vector<client::StreamState> streams() const { return open().streams(); }
   std::map<std::string, client::DeviceState> devices() const { return open().devices(); }
   std::map<std::string, std::int64_t> rejections() const { return open().rejections().by_reason; }
+  std::optional<std::map<std::string, std::int64_t>> authentication() const {
+    const auto a = open().authentication();
+    if (!a) return std::nullopt;
+    return std::map<std::string, std::int64_t>{{"authenticated", a->authenticated},
+                                                {"unauthenticated", a->unauthenticated},
+                                                {"forged", a->forged},
+                                                {"replayed", a->replayed}};
+  }
   std::int64_t callback_errors() const { return *callback_errors_; }
   bool closed() const { return !sub_; }
 
@@ -267,11 +277,14 @@ void bind_subscriber(py::module_& m) {
 
   py::class_<PySubscriber>(m, "Subscriber",
                            "Receives covtrack pose streams and heartbeats over LCM on a thread of its own.")
-      .def(py::init<const std::optional<std::string>&, const std::string&, double>(), py::arg("lcm_url") = py::none(),
-           py::arg("streams") = ".*", py::arg("stale_after_s") = 0.5,
+      .def(py::init<const std::optional<std::string>&, const std::string&, double, const std::optional<std::string>&>(),
+           py::arg("lcm_url") = py::none(), py::arg("streams") = ".*", py::arg("stale_after_s") = 0.5,
+           py::arg("key_file") = py::none(),
            "lcm_url: None for $LCM_DEFAULT_URL or LCM's default. streams: a POSIX extended regular "
-           "expression that must match 'device/sensor' whole. Raises RuntimeError when LCM cannot be "
-           "used (e.g. no multicast route: the message says how to add one).")
+           "expression that must match 'device/sensor' whole. key_file: the daemon's shared key "
+           "(its [auth] key_file; None: $COVTRACK_KEY_FILE, if set): only authenticated messages are "
+           "accepted. Raises RuntimeError when LCM cannot be used (e.g. no multicast route: the "
+           "message says how to add one) or the key file cannot.")
       .def("on_pose", &PySubscriber::on_pose, py::arg("callback"), py::arg("pattern") = ".*",
            "Calls callback(pose) for every accepted report of the streams whose 'device/sensor' "
            "matches pattern, on the receiving thread with the GIL held: keep it short. An exception "
@@ -289,6 +302,8 @@ void bind_subscriber(py::module_& m) {
       .def("devices", &PySubscriber::devices, "Every device heard so far: {name: Device}")
       .def("rejections", &PySubscriber::rejections,
            "Messages rejected so far, by reason: {'bad length': 2, 'invalid pose': 1, ...}")
+      .def("authentication", &PySubscriber::authentication,
+           "With a key: {'authenticated': n, 'unauthenticated': n, 'forged': n, 'replayed': n}; else None")
       .def_property_readonly("callback_errors", &PySubscriber::callback_errors)
       .def_property_readonly("closed", &PySubscriber::closed)
       .def("close", &PySubscriber::close, "Stops receiving (idempotent); no callback runs after it.")

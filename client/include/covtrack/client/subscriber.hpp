@@ -27,6 +27,13 @@
 // Heartbeats are checked the same way (decode_status()). Every rejection is counted by
 // its reason in rejections(); those of a stream's channel also in its counters.
 //
+// Authentication (docs/authentication.md): given a key file, every message must carry a
+// valid trailer (message_auth.hpp), checked before anything else; a message without one,
+// with one that fails its MAC (a forgery, another key, altered bytes) or that was seen
+// before or sent more than auth_max_age_s ago (a replay) is refused and counted in
+// authentication() and rejections(), not in a stream's counters: it never creates a
+// stream nor counts as its loss. Without a key, trailers are ignored.
+//
 // Silence: a stream without a message for stale_after_s is stale (it keeps its last
 // value). A device whose heartbeats were heard and then stop for 3 of their periods is
 // unreachable (devices()): each of its streams is reported LOST at once, through latest()
@@ -61,9 +68,27 @@ struct SubscriberOptions {
   // The largest forward jump of a stream's sequence still counted as loss; beyond it, or
   // backwards, a message is off the stream's track (SequenceTracker).
   std::int64_t sequence_window = 1000;
+  // The daemon's shared key (its [auth] key_file); empty: $COVTRACK_KEY_FILE, and when
+  // that is unset too, no authentication.
+  std::string key_file = {};
+  // With a key: the oldest an authenticated message may be by its sender's clock (and
+  // the farthest in the future), so a message captured earlier cannot be replayed from
+  // a daemon instance this subscriber never heard from; hosts' clocks must agree within it.
+  // Above 0, at most a day.
+  double auth_max_age_s = 2.0;
 };
 
-// Every message on a stream's channel is received, rejected or foreign, exactly one.
+// With a key: what authentication let through and refused, by kind.
+struct AuthCounters {
+  std::string key_file;
+  std::int64_t authenticated = 0;    // a valid MAC, not a replay: then checked as any message
+  std::int64_t unauthenticated = 0;  // no trailer
+  std::int64_t forged = 0;           // a trailer whose MAC fails
+  std::int64_t replayed = 0;         // seen before, or sent outside auth_max_age_s
+};
+
+// Every message on a stream's channel is received, rejected or foreign, exactly one
+// (with a key: every authenticated one; see authentication()).
 struct StreamCounters {
   std::int64_t received = 0;  // accepted and delivered
   std::int64_t lost = 0;      // sequence numbers skipped by a forward jump within sequence_window
@@ -88,7 +113,7 @@ class Subscriber {
   using PoseCallback = std::function<void(const TrackedTransform&)>;
 
   // Opens its own LCM instance. Fails at once, with how to fix it, on an unusable URL
-  // (no multicast route: no 10 s LCM self-test hang) or a bad pattern.
+  // (no multicast route: no 10 s LCM self-test hang), a bad pattern or key file.
   static Result<std::unique_ptr<Subscriber>> open(const SubscriberOptions& options);
 
   // Receives on an LCM instance the caller shares, e.g. one memq:// instance that the
@@ -116,6 +141,8 @@ class Subscriber {
   // Every message rejected so far (poses, heartbeats, channels that name no stream, and
   // on udpm:// datagrams that are not LCM's format).
   RejectionTally rejections() const;
+  // With a key, the authentication counters; nothing without one.
+  std::optional<AuthCounters> authentication() const;
 
   // On udpm://, the socket receive buffer asked for and granted, with a note when
   // net.core.rmem_max capped it (a program should show the note); nothing otherwise.

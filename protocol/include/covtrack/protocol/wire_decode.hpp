@@ -5,7 +5,8 @@
 // throw std::length_error (the process ends), an array length makes it allocate before it
 // checks the size. Every covtrack program decodes through here instead: the bytes are
 // walked field by field first (type fingerprint, every string and array length inside the
-// message, nothing after the last field, names and text by their rules), and only then
+// message, nothing after the last field but an authentication trailer (message_auth.hpp,
+// not checked here), names and text by their rules), and only then
 // handed to LCM's decoder, whose failures are caught as well. A message that passes
 // holds only valid UTF-8, so JSON and terminals can take its strings as they are. A message that fails is rejected with a fault and a
 // detail saying which field, where; protocol/README.md, "Receiving", lists the checks.

@@ -52,6 +52,7 @@ struct ArSceneOptions {
   osg::Vec4 selected_colour{0.2f, 1, 0.3f, 1};
   osg::Vec4 preselected_colour{1, 1, 1, 1};
   osg::Vec4 pointer_colour{1, 0.3f, 1, 1};
+  osg::Vec4 target_panel_colour{0.12f, 0.12f, 0.12f, 1};  // behind a two-step target's name
   osg::Vec4 clear_colour{0, 0, 0, 1};      // behind everything until a video frame is set
   float line_width_px = 2;
   bool draw_regions = true;
@@ -95,10 +96,12 @@ class ArScene {
   osg::ref_ptr<osg::Texture2D> video_;
   osg::ref_ptr<osg::Geometry> video_quad_;
   void draw_selection(const client::ArFrame& frame, const SelectionDrawing& selection);
-  std::array<osg::Geometry*, 5> overlay_lines() const;
+  std::array<osg::Geometry*, 7> overlay_lines() const;
 
   osg::ref_ptr<osg::Geometry> outer_lines_, inner_lines_, selected_lines_, preselected_lines_, pointer_lines_;
-  osg::ref_ptr<osg::Geode> labels_;
+  // Two-step targets over everything else: a filled panel, its outline, its name.
+  osg::ref_ptr<osg::Geometry> target_panels_, target_lines_;
+  osg::ref_ptr<osg::Geode> labels_, target_labels_;
   std::vector<osg::ref_ptr<osgText::Text>> target_texts_;  // grown as targets need
   std::vector<osg::ref_ptr<osg::MatrixTransform>> transforms_;
   std::vector<osg::ref_ptr<osg::Switch>> switches_;
