@@ -9,7 +9,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build-sanitize}
-tests=(protocol_test channels_test wire_decode_test lcm_datagram_test lenz_decoder_test
+tests=(protocol_test channels_test wire_decode_test lcm_datagram_test message_auth_test lenz_decoder_test
        serial6dof_decoder_test hydra_test motion_gate_test vrpn_wire_test config_test vrpn_config_test
        lcmlog_file_test lcmlog_replay_test scene_test sequence_tracker_test)
 tests/configure_sanitized.sh "$build"
