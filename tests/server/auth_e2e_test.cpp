@@ -23,6 +23,7 @@
 #include "covtrack/protocol/message_auth.hpp"
 #include "client/pose_messages.hpp"
 #include "daemon_process.hpp"
+#include "support/wait_for.hpp"
 
 using namespace covtrack;
 using namespace std::chrono_literals;
@@ -50,15 +51,7 @@ std::string config(const std::string& key_file) {
          "sigma_m = [0.001, 0.001, 0.001]\nsigma_rad = [0.002, 0.002, 0.002]\n";
 }
 
-template <typename C>
-bool wait_for(C condition, std::chrono::seconds deadline = 20s) {
-  const auto end = std::chrono::steady_clock::now() + deadline;
-  while (std::chrono::steady_clock::now() < end) {
-    if (condition()) return true;
-    std::this_thread::sleep_for(10ms);
-  }
-  return condition();
-}
+using covtrack::testing::wait_for;
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path);

@@ -13,6 +13,7 @@
 
 #include "covtrack/client/subscriber.hpp"
 #include "daemon_process.hpp"
+#include "support/wait_for.hpp"
 
 using namespace covtrack;
 using namespace std::chrono_literals;
@@ -28,17 +29,7 @@ std::string sim_config() {
   return text.str();
 }
 
-// Waits for `condition`, checking every 20 ms; the deadline is generous (the heartbeat
-// period is 1 s): only a failure waits for it.
-template <typename C>
-bool wait_for(C condition, std::chrono::seconds deadline = 20s) {
-  const auto end = std::chrono::steady_clock::now() + deadline;
-  while (std::chrono::steady_clock::now() < end) {
-    if (condition()) return true;
-    std::this_thread::sleep_for(20ms);
-  }
-  return condition();
-}
+using covtrack::testing::wait_for;
 
 bool all_reachable(const client::Subscriber& sub, std::size_t devices) {
   const auto d = sub.devices();

@@ -47,4 +47,10 @@ Result<RegionsReport> compute_regions(const RegionsModel& model, const client::T
   return report;
 }
 
+std::vector<client::Selectable> selectables_of(const RegionsReport& report) {
+  std::vector<client::Selectable> objects;
+  for (const RegionsReport::Object& o : report.objects) objects.push_back(client::selectable_of(o.regions));
+  return objects;
+}
+
 }  // namespace covtrack::cli

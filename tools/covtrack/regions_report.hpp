@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "covtrack/client/regions.hpp"
+#include "covtrack/client/selection.hpp"
 #include "covtrack/client/transform_graph.hpp"
 #include "covtrack/protocol/result.hpp"
 #include "covtrack/scene/scene_graph.hpp"
@@ -47,5 +48,8 @@ std::vector<std::string> flag_names(const client::ProjectionFlags& flags);
 // frame is not connected to the camera's.
 Result<RegionsReport> compute_regions(const RegionsModel& model, const client::TransformGraph& graph,
                                       std::int64_t time_us, client::ProjectionMethod method);
+
+// The objects as selection sees them: where each can be on the screen (its outer region).
+std::vector<client::Selectable> selectables_of(const RegionsReport& report);
 
 }  // namespace covtrack::cli

@@ -73,12 +73,6 @@ std::optional<client::Pointer> tracked_pointer(const RegionsModel& model, const 
   return client::pointer_from_projection(*report.pointer_tip, report.confidence);
 }
 
-std::vector<client::Selectable> selectables_of(const RegionsReport& report) {
-  std::vector<client::Selectable> objects;
-  for (const RegionsReport::Object& o : report.objects) objects.push_back(client::selectable_of(o.regions));
-  return objects;
-}
-
 // What the pointer selects now, for the legend.
 std::string pointer_line(const RegionsReport& report, const WidgetFrame& w) {
   if (!w.pointer) return {};

@@ -40,12 +40,12 @@ WidgetFrame ViewWidgets::update(const RegionsReport& report, const cv::Size& scr
   }
   if (!frame.pointer) return frame;
 
-  // Objects are selected by their outer regions: where the object can be on the screen.
-  std::vector<client::Selectable> selectables;
-  for (const RegionsReport::Object& o : report.objects) selectables.push_back(client::selectable_of(o.regions));
-  frame.likelihoods = likelihood_ == scene::Likelihood::distance
-                          ? client::likelihoods_by_distance(*frame.pointer, selectables)
-                          : client::likelihoods_by_area(*frame.pointer, selectables);
+  const std::vector<client::Selectable> selectables = selectables_of(report);
+  // A user's session has the area likelihoods already (for this pointer and these objects).
+  if (likelihood_ == scene::Likelihood::distance)
+    frame.likelihoods = client::likelihoods_by_distance(*frame.pointer, selectables);
+  else
+    frame.likelihoods = user ? user->likelihoods : client::likelihoods_by_area(*frame.pointer, selectables);
   if (frame.preselect) frame.selection = client::select_direct(frame.likelihoods, selectables);
   if (user) {
     frame.targets = user->targets;  // laid out by a click, waiting for the next

@@ -82,10 +82,9 @@ void add_lines(osg::Geometry& g, GLenum mode, std::span<const client::Vec2> poin
   g.addPrimitiveSet(new osg::DrawArrays(mode, first, static_cast<GLsizei>(points.size())));
 }
 
-void in_bin(osg::Object& node_or_drawable, int bin, const char* kind, osg::StateSet::RenderBinMode mode) {
-  osg::StateSet* state = node_or_drawable.asNode() ? node_or_drawable.asNode()->getOrCreateStateSet()
-                                                   : static_cast<osg::Drawable&>(node_or_drawable).getOrCreateStateSet();
-  state->setRenderBinDetails(bin, kind, mode);
+// Drawables are nodes too (OSG 3.4 on): one call sets either's render bin.
+void in_bin(osg::Node& node, int bin, const char* kind, osg::StateSet::RenderBinMode mode) {
+  node.getOrCreateStateSet()->setRenderBinDetails(bin, kind, mode);
 }
 
 void finish_lines(osg::Geometry& g) {
