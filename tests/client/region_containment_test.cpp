@@ -82,7 +82,7 @@ Camera pinhole() {
 // direction n, the half-plane up to the p-quantile of max_i n . x_i (else the object would
 // cross that line in more than 1 - p of the draws): their intersection is a lower bound.
 double support_quantile_area(const std::vector<std::vector<Vec2>>& draws, double p) {
-  constexpr int kDirections = 360;
+  constexpr int kDirections = 180;
   Polygon region;
   Eigen::AlignedBox2d box;
   for (const auto& d : draws)

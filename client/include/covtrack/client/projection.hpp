@@ -54,7 +54,7 @@ struct UnscentedParams {
 enum class ProjectionMethod { unscented, linear };
 
 // ProjectionOptions::max_depth_sigma_ratio's default (see there).
-inline constexpr double kDefaultMaxDepthSigmaRatio = 0.1;
+inline constexpr double kDefaultMaxDepthSigmaRatio = 0.07;
 
 struct ProjectionOptions {
   ProjectionMethod method = ProjectionMethod::unscented;
