@@ -210,11 +210,11 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
   const Camera cam = camera;
   const double wm0 = s.wm0, wc0 = s.wc0, wi = s.wi;
   double u[kSigmaPoints][kBlock], v[kSigmaPoints][kBlock], zmin[kBlock], z0[kBlock], r2max[kBlock];
-  double zs[kSigmaPoints][kBlock];
+  double dz1[kBlock], dz2[kBlock];  // sums of the sigma points' depths less z0, and of their squares
   for (int j = 0; j < kBlock; ++j) {
     const auto& m = s.pose;
     z0[j] = zmin[j] = m[6][0] * px[j] + m[7][0] * py[j] + m[8][0] * pz[j] + m[11][0];
-    r2max[j] = 0;
+    r2max[j] = 0, dz1[j] = 0, dz2[j] = 0;
   }
   for (int i = 0; i < kSigmaPoints; ++i) {
     double m[12];  // pose i
@@ -226,27 +226,30 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
       // A point behind the camera gives a meaningless pixel here; the caller checks zmin.
       const double iz = 1 / z, xn = x * iz, yn = y * iz;
       cam.pixel_of_normalised(xn, yn, u[i][j], v[i][j]);
-      zs[i][j] = z;
+      const double dz = i > 0 ? z - z0[j] : 0.0;
+      dz1[j] += dz, dz2[j] += dz * dz;
       zmin[j] = std::min(zmin[j], z);
       r2max[j] = std::max(r2max[j], xn * xn + yn * yn);
     }
   }
-  double mu[kBlock], mv[kBlock], mz[kBlock], cuu[kBlock], cuv[kBlock], cvv[kBlock], czz[kBlock];
-  for (int j = 0; j < kBlock; ++j) mu[j] = wm0 * u[0][j], mv[j] = wm0 * v[0][j], mz[j] = wm0 * zs[0][j];
+  double mu[kBlock], mv[kBlock], cuu[kBlock], cuv[kBlock], cvv[kBlock];
+  for (int j = 0; j < kBlock; ++j) mu[j] = wm0 * u[0][j], mv[j] = wm0 * v[0][j];
   for (int i = 1; i < kSigmaPoints; ++i)
-    for (int j = 0; j < kBlock; ++j) mu[j] += wi * u[i][j], mv[j] += wi * v[i][j], mz[j] += wi * zs[i][j];
+    for (int j = 0; j < kBlock; ++j) mu[j] += wi * u[i][j], mv[j] += wi * v[i][j];
   for (int j = 0; j < kBlock; ++j) {
-    const double du = u[0][j] - mu[j], dv = v[0][j] - mv[j], dz = zs[0][j] - mz[j];
-    cuu[j] = wc0 * du * du, cuv[j] = wc0 * du * dv, cvv[j] = wc0 * dv * dv, czz[j] = wc0 * dz * dz;
+    const double du = u[0][j] - mu[j], dv = v[0][j] - mv[j];
+    cuu[j] = wc0 * du * du, cuv[j] = wc0 * du * dv, cvv[j] = wc0 * dv * dv;
   }
   for (int i = 1; i < kSigmaPoints; ++i)
     for (int j = 0; j < kBlock; ++j) {
-      const double du = u[i][j] - mu[j], dv = v[i][j] - mv[j], dz = zs[i][j] - mz[j];
-      cuu[j] += wi * du * du, cuv[j] += wi * du * dv, cvv[j] += wi * dv * dv, czz[j] += wi * dz * dz;
+      const double du = u[i][j] - mu[j], dv = v[i][j] - mv[j];
+      cuu[j] += wi * du * du, cuv[j] += wi * du * dv, cvv[j] += wi * dv * dv;
     }
   for (int j = 0; j < kBlock; ++j) {
     out.u0[j] = u[0][j], out.v0[j] = v[0][j], out.z0[j] = z0[j], out.zmin[j] = zmin[j], out.r2max[j] = r2max[j];
-    out.zvar[j] = czz[j];
+    // The depth's variance about its mean (z0 + wi dz1; the centre's deviation, 0, has wc0).
+    const double mean_dz = wi * dz1[j];
+    out.zvar[j] = wi * dz2[j] - 2 * wi * dz1[j] * mean_dz + (2 * kN * wi) * mean_dz * mean_dz + wc0 * mean_dz * mean_dz;
     out.mean_u[j] = mu[j], out.mean_v[j] = mv[j];
     out.cuu[j] = cuu[j], out.cuv[j] = cuv[j], out.cvv[j] = cvv[j];
   }

@@ -18,11 +18,13 @@ namespace {
 constexpr std::size_t kLanes = 8;
 
 // An upper bound, within 0.01 rad, of the angle atan2(y, x) in [0, pi] for y >= 0, without
-// trigonometry: 2 atan(t) for the half angle's tangent t = y / (r + x), with atan(t) within
+// trigonometry: 2 atan(t) for the half angle's tangent t, with atan(t) within
 // 0.005 rad of t / (1 + 0.28125 t^2) for t <= 1, of pi/2 - t / (t^2 + 0.28125) beyond.
 inline double angle_at_most(double y, double x) {
   const double r = std::sqrt(x * x + y * y);
-  const double t = y / std::max(r + x, 1e-300 * (r + 1));  // r + x = 0: t huge, the angle pi
+  // t = y / (r + x) = (r - x) / y, the first where x >= 0, the second (capped: y may be 0,
+  // opposite directions, pi) where x < 0: neither divides by a small difference.
+  const double t = x >= 0 ? y / std::max(r + x, 1e-300) : std::min((r - x) / y, 1e300);
   const double half = t <= 1 ? t / (1 + 0.28125 * t * t) : std::numbers::pi / 2 - t / (t * t + 0.28125);
   return std::min(2 * (half + 0.005), std::numbers::pi);
 }
@@ -33,8 +35,9 @@ inline double angle_at_most(double y, double x) {
 // derivative by the object-frame point (2x3, rows m0, m1). Fixed arrays, so that the
 // compiler sees that they do not overlap.
 struct EdgeBlock {
-  double px[kLanes + 1], py[kLanes + 1], pz[kLanes + 1], sxx[kLanes + 1], sxy[kLanes + 1], syy[kLanes + 1],
-      nx[kLanes + 1], ny[kLanes + 1];
+  double px[kLanes + 1], py[kLanes + 1], pz[kLanes + 1], sxx[kLanes + 1], sxy[kLanes + 1], syy[kLanes + 1];
+  double u[kLanes + 2], v[kLanes + 2];  // mean pixels, one more: the normal of lane kLanes's edge
+  double nx[kLanes + 1], ny[kLanes + 1];
   double m00[kLanes + 1], m01[kLanes + 1], m02[kLanes + 1], m10[kLanes + 1], m11[kLanes + 1], m12[kLanes + 1];
   double length[kLanes];
 };
@@ -46,6 +49,9 @@ COVTRACK_VECTOR_CLONES
 void edge_lengths(const double (&C)[36], const double (&R)[9], const double (&t)[3], double fx, double fy,
                   EdgeBlock& h) {
   for (std::size_t l = 0; l <= kLanes; ++l) {
+    const double du = h.u[l + 1] - h.u[l], dv = h.v[l + 1] - h.v[l], d2 = du * du + dv * dv;
+    const double inverse = d2 > 0 ? 1 / std::sqrt(d2) : 0.0;  // no edge: no normal, no angle
+    h.nx[l] = dv * inverse, h.ny[l] = -du * inverse;
     const double x = R[0] * h.px[l] + R[1] * h.py[l] + R[2] * h.pz[l] + t[0];
     const double y = R[3] * h.px[l] + R[4] * h.py[l] + R[5] * h.pz[l] + t[1];
     const double z = R[6] * h.px[l] + R[7] * h.py[l] + R[8] * h.pz[l] + t[2];
@@ -133,16 +139,14 @@ double whole_object_scale2(const Camera& camera, const UncertainPose& pose,
   EdgeBlock h;
   double length = 0;
   for (std::size_t first = 0; first < k; first += kLanes) {
-    for (std::size_t l = 0; l <= kLanes; ++l) {
-      const std::size_t i = (first + l) % k, j = (i + 1) % k;
+    for (std::size_t l = 0, i = first % k; l <= kLanes + 1; ++l, i = i + 1 == k ? 0 : i + 1) {
+      const ProjectedVertex& pv = projected[mean_hull[i]];
+      h.u[l] = pv.mean_px.x(), h.v[l] = pv.mean_px.y();
+      if (l > kLanes) break;
       const Vec3& p = vertices_object[mean_hull[i]];
       h.px[l] = p.x(), h.py[l] = p.y(), h.pz[l] = p.z();
-      const Mat2& S = projected[mean_hull[i]].covariance_px2;
+      const Mat2& S = pv.covariance_px2;
       h.sxx[l] = S(0, 0), h.sxy[l] = 0.5 * (S(0, 1) + S(1, 0)), h.syy[l] = S(1, 1);
-      const Vec2 d = projected[mean_hull[j]].mean_px - projected[mean_hull[i]].mean_px;
-      const double d2 = d.squaredNorm();
-      const Vec2 n = d2 > 0 ? Vec2(d.y(), -d.x()) / std::sqrt(d2) : Vec2(1, 0);
-      h.nx[l] = n.x(), h.ny[l] = n.y();
     }
     edge_lengths(C, R, t, camera.fx, camera.fy, h);
     for (std::size_t l = 0; l < kLanes && first + l < k; ++l) length += h.length[l];

@@ -149,3 +149,28 @@ TEST(RegionsCli, ObjectBehindTheCameraIsFlaggedNotProjected) {
   EXPECT_TRUE(o["outer_px"].empty());
   for (const auto& v : o["vertices"]) EXPECT_TRUE(v["mean_px"].is_null());
 }
+
+// Depth known to 10% of the distance (a monocular tracker's range, say): the ellipses are
+// still drawn, and every vertex and the object say that their shape is in doubt. (The
+// shipped scenes above carry no flag.)
+TEST(RegionsCli, DepthSpreadLargeAgainstTheDepthIsFlagged) {
+  const std::filesystem::path scene = std::filesystem::temp_directory_path() / "covtrack_depth_spread.toml";
+  std::ofstream(scene) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR
+                          "/config/cameras/example_640x480.yml\"\n"
+                          "[[transform]]\nparent = \"camera\"\nchild = \"thing\"\nposition_m = [0, 0, 1.5]\n"
+                          "sigma_m = [0.005, 0.005, 0.15]\nsigma_rad = [0.01, 0.01, 0.01]\n"
+                          "[[object]]\nname = \"far_off\"\nframe = \"thing\"\nbox_m = [0.2, 0.2, 0.2]\n";
+  const CliRun r = run(scene.string() + " --json");
+  std::filesystem::remove(scene);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const nlohmann::json doc = nlohmann::json::parse(r.out, nullptr, false);
+  ASSERT_FALSE(doc.is_discarded()) << r.out;
+  const auto& o = doc["objects"][0];
+  EXPECT_TRUE(o["valid"].get<bool>());
+  EXPECT_EQ(o["flags"], nlohmann::json::array({"depth_nonlinear"}));
+  EXPECT_FALSE(o["outer_px"].empty());
+  for (const auto& v : o["vertices"]) {
+    EXPECT_GT(v["depth_sigma_m"].get<double>(), 0.07 * v["depth_m"].get<double>());
+    EXPECT_EQ(v["flags"], nlohmann::json::array({"depth_nonlinear"}));
+  }
+}
