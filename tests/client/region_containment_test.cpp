@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <numbers>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -104,6 +105,22 @@ double support_quantile_area(const std::vector<std::vector<Vec2>>& draws, double
   return polygon_area(region);
 }
 
+// Pixels of the points under `draws` poses drawn from the pose's covariance (T Exp(xi)).
+std::vector<std::vector<Vec2>> draw_pixels(const Camera& camera, const UncertainPose& pose,
+                                           std::span<const Vec3> points, std::mt19937_64& rng) {
+  std::normal_distribution<double> normal;
+  const Mat6 L = Eigen::LLT<Mat6>(pose.covariance).matrixL();
+  std::vector<std::vector<Vec2>> draws(kDraws);
+  for (auto& pixels : draws) {
+    Vec6 z;
+    for (int k = 0; k < 6; ++k) z[k] = normal(rng);
+    const Pose T = pose.T * se3_exp(L * z);
+    for (const Vec3& p : points) pixels.push_back(camera.project(T * p));
+    pixels = convex_hull(pixels);  // inside a convex region iff its hull is; and quicker
+  }
+  return draws;
+}
+
 struct Scene {
   std::string camera_name;
   Camera camera;
@@ -123,16 +140,7 @@ void check_containment(const Scene& scene, std::uint64_t seed) {
   per_vertex.regions.whole_object = false;
 
   // The same draws for every confidence.
-  std::normal_distribution<double> normal;
-  const Mat6 L = Eigen::LLT<Mat6>(pose.covariance).matrixL();
-  std::vector<std::vector<Vec2>> draws(kDraws);
-  for (auto& pixels : draws) {
-    Vec6 z;
-    for (int k = 0; k < 6; ++k) z[k] = normal(rng);
-    const Pose T = pose.T * se3_exp(L * z);
-    for (const Vec3& p : points) pixels.push_back(scene.camera.project(T * p));
-    pixels = convex_hull(pixels);  // inside a convex region iff its hull is; and quicker
-  }
+  const std::vector<std::vector<Vec2>> draws = draw_pixels(scene.camera, pose, points, rng);
   const auto fraction_inside = [&](const Polygon& region) {
     int inside = 0;
     for (const auto& pixels : draws)
@@ -190,14 +198,7 @@ TEST(WholeObjectContainment, PointObjectAgainstItsEllipseAndTheSupportBound) {
   const UncertainPose pose{pose_from(Vec3(0.05, 0, 1.0), Eigen::Quaterniond::Identity()),
                            correlated_covariance(0.004, 3 * kDeg, rng), false};
   const std::vector<Vec3> point = {Vec3(0.02, 0.01, 0)};
-  std::normal_distribution<double> normal;
-  const Mat6 L = Eigen::LLT<Mat6>(pose.covariance).matrixL();
-  std::vector<std::vector<Vec2>> draws(kDraws);
-  for (auto& d : draws) {
-    Vec6 z;
-    for (int k = 0; k < 6; ++k) z[k] = normal(rng);
-    d.push_back(camera.project(pose.T * se3_exp(L * z) * point[0]));
-  }
+  const std::vector<std::vector<Vec2>> draws = draw_pixels(camera, pose, point, rng);
   for (double p : kConfidences) {
     ObjectRegionOptions o;
     o.projection.add_intrinsic_uncertainty = false;

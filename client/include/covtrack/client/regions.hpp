@@ -9,8 +9,11 @@
 //    of the ellipse; N is the smallest count meeting RegionOptions::max_polygon_error_px.
 //  - Outer region (expansion, 5.5.1): the convex hull of the ellipses, as the
 //    intersection of its support half-planes {n . x <= h(n)}, h(n) = max over the ellipses
-//    of n . c + sqrt(n^T S n). It contains every ellipse, so each vertex lies in it with
-//    probability >= p. Directions start 45 degrees apart; a gap is split while the corner
+//    of n . c + sqrt(n^T S n). compute_object_regions scales the ellipses by the whole
+//    object's quantile (whole_object_scale2), so that the WHOLE object, every vertex and
+//    edge at once, lies in it with probability >= p (docs/regions.md: the argument and the
+//    Monte Carlo checks); at one vertex's scale (expand_region alone, or
+//    RegionOptions::whole_object false) each vertex alone does. Directions start 45 degrees apart; a gap is split while the corner
 //    of its two lines is farther than max_polygon_error_px from the chord between their
 //    contact points and, when one ellipse touches both lines, from that ellipse's point
 //    facing the corner (both lie inside the hull), so every corner, hence every point of
