@@ -198,6 +198,7 @@ struct UnscentedBlock {
   double z0[kBlock];              // its camera depth
   double zmin[kBlock];            // the nearest depth over all sigma points
   double r2max[kBlock];           // the largest normalised radius^2 over all sigma points
+  double zvar[kBlock];            // the depth's variance over the sigma points
   double mean_u[kBlock], mean_v[kBlock];
   double cuu[kBlock], cuv[kBlock], cvv[kBlock];
 };
@@ -209,10 +210,11 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
   const Camera cam = camera;
   const double wm0 = s.wm0, wc0 = s.wc0, wi = s.wi;
   double u[kSigmaPoints][kBlock], v[kSigmaPoints][kBlock], zmin[kBlock], z0[kBlock], r2max[kBlock];
+  double dz1[kBlock], dz2[kBlock];  // sums of the sigma points' depths less z0, and of their squares
   for (int j = 0; j < kBlock; ++j) {
     const auto& m = s.pose;
     z0[j] = zmin[j] = m[6][0] * px[j] + m[7][0] * py[j] + m[8][0] * pz[j] + m[11][0];
-    r2max[j] = 0;
+    r2max[j] = 0, dz1[j] = 0, dz2[j] = 0;
   }
   for (int i = 0; i < kSigmaPoints; ++i) {
     double m[12];  // pose i
@@ -224,6 +226,8 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
       // A point behind the camera gives a meaningless pixel here; the caller checks zmin.
       const double iz = 1 / z, xn = x * iz, yn = y * iz;
       cam.pixel_of_normalised(xn, yn, u[i][j], v[i][j]);
+      const double dz = i > 0 ? z - z0[j] : 0.0;
+      dz1[j] += dz, dz2[j] += dz * dz;
       zmin[j] = std::min(zmin[j], z);
       r2max[j] = std::max(r2max[j], xn * xn + yn * yn);
     }
@@ -243,6 +247,9 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
     }
   for (int j = 0; j < kBlock; ++j) {
     out.u0[j] = u[0][j], out.v0[j] = v[0][j], out.z0[j] = z0[j], out.zmin[j] = zmin[j], out.r2max[j] = r2max[j];
+    // The depth's variance about its mean (z0 + wi dz1; the centre's deviation, 0, has wc0).
+    const double mean_dz = wi * dz1[j];
+    out.zvar[j] = wi * dz2[j] - 2 * wi * dz1[j] * mean_dz + (2 * kN * wi) * mean_dz * mean_dz + wc0 * mean_dz * mean_dz;
     out.mean_u[j] = mu[j], out.mean_v[j] = mv[j];
     out.cuu[j] = cuu[j], out.cuv[j] = cuv[j], out.cvv[j] = cvv[j];
   }
@@ -251,7 +258,7 @@ void unscented_block(const Camera& camera, const SigmaPoses& s, const double (&p
 // The first-order path in the same blocks: per vertex J = J_camera R [I, -skew(p)]
 // (pixel_jacobian_wrt_perturbation) and J C J^T, written out over the block's lanes.
 struct LinearBlock {
-  double u[kBlock], v[kBlock], z[kBlock], r2[kBlock];
+  double u[kBlock], v[kBlock], z[kBlock], r2[kBlock], zvar[kBlock];
   double cuu[kBlock], cuv[kBlock], cvv[kBlock];
 };
 
@@ -297,6 +304,15 @@ void linear_block(const Camera& camera, const Pose& T, const Mat6& covariance,
     double uu = 0, uv = 0, vv = 0;
 #pragma GCC unroll 6
     for (int a = 0; a < 6; ++a) uu += J[0][a] * CJ0[a], uv += J[0][a] * CJ1[a], vv += J[1][a] * CJ1[a];
+    // The depth's row, R's third row times [I, -skew(p)], and its variance.
+    const double Jz[6] = {R[6], R[7], R[8], py[j] * R[8] - pz[j] * R[7], pz[j] * R[6] - px[j] * R[8],
+                          px[j] * R[7] - py[j] * R[6]};
+    double zz = 0;
+#pragma GCC unroll 6
+    for (int a = 0; a < 6; ++a)
+#pragma GCC unroll 6
+      for (int b = 0; b < 6; ++b) zz += Jz[a] * C[6 * a + b] * Jz[b];
+    out.zvar[j] = zz;
     out.u[j] = u, out.v[j] = v, out.z[j] = z, out.r2[j] = xn * xn + yn * yn;
     out.cuu[j] = uu, out.cuv[j] = uv, out.cvv[j] = vv;
   }
@@ -324,6 +340,12 @@ ProjectedVertex& start_vertex(std::vector<ProjectedVertex>& out, double depth_m,
   return v;
 }
 
+// The depth's spread, and the flag when it is a large fraction of the depth.
+void set_depth_sigma(ProjectedVertex& v, double depth_variance, const ProjectionOptions& o) {
+  v.depth_sigma_m = std::sqrt(std::max(depth_variance, 0.0));
+  v.flags.depth_nonlinear = v.depth_sigma_m > o.max_depth_sigma_ratio * v.depth_m;
+}
+
 void project_linear(const Camera& camera, const UncertainPose& pose,
                     std::span<const Vec3> points, const ProjectionOptions& o,
                     const ProjectionFlags& shared, std::vector<ProjectedVertex>& out) {
@@ -338,6 +360,7 @@ void project_linear(const Camera& camera, const UncertainPose& pose,
       ProjectedVertex& v = start_vertex(out, b.z[j], shared, o);
       if (v.flags.behind_camera) continue;
       v.mean_px = Vec2(b.u[j], b.v[j]);
+      set_depth_sigma(v, b.zvar[j], o);
       if ((v.flags.past_distortion_fold = b.r2[j] >= fold_r2)) continue;
       v.covariance_px2 << b.cuu[j], b.cuv[j], b.cuv[j], b.cvv[j];
       if (add_intrinsic) v.covariance_px2 += camera.intrinsic_covariance_at(v.mean_px);
@@ -360,6 +383,7 @@ void project_unscented(const Camera& camera, const UncertainPose& pose,
       ProjectedVertex& v = start_vertex(out, b.z0[j], shared, o);
       if (v.flags.behind_camera) continue;
       v.mean_px = Vec2(b.u0[j], b.v0[j]);
+      set_depth_sigma(v, b.zvar[j], o);
       if (b.zmin[j] < o.near_m) {
         // A pixel from behind the camera would poison the sums: no covariance.
         v.flags.sigma_point_behind_camera = true;

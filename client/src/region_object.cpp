@@ -18,6 +18,7 @@ void compute_object_regions(const Camera& camera, const UncertainPose& T_camera_
   }
   r.outer.clear();
   r.inner.clear();
+  r.outer_scale = 0;
   if (!r.valid) {
     r.hull.clear();
     r.assessment = std::numeric_limits<double>::infinity();
@@ -43,10 +44,16 @@ void compute_object_regions(const Camera& camera, const UncertainPose& T_camera_
   // (region_tangents.hpp).
   thread_local std::vector<TangentLine> inner_lines, outer_lines;
   outer_lines.clear();  // stays empty without the shortcut
+  // The inner region at one vertex's scale, the outer at the whole object's.
   const double s2 = std::pow(confidence_scale(o.regions.confidence), 2);
-  hull_tangents(hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return hull[i]; }, s2,
+  const double outer_s2 = o.regions.whole_object
+                              ? whole_object_scale2(camera, T_camera_object, vertices_object, r.vertices,
+                                                    r.hull, o.regions.confidence)
+                              : s2;
+  r.outer_scale = std::sqrt(outer_s2);
+  hull_tangents(hull.size(), [&](std::size_t i) -> const ProjectedVertex& { return hull[i]; }, s2, outer_s2,
                 &inner_lines, o.regions.outer_by_arcs ? &outer_lines : nullptr);
-  expand_region(r.vertices, r.hull, outer_lines, s2, o.regions, r.outer);
+  expand_region(r.vertices, r.hull, outer_lines, outer_s2, o.regions, r.outer);
   contract_region(hull, inner_lines, r.inner);
   r.assessment = assess(o.assessment, hull);
   hull_pool = std::move(hull);

@@ -120,16 +120,21 @@ void common_tangents(TangentBlock& block) {
 namespace {
 
 // Half `half` of a block's lanes (0 or 1) from the ellipses of the edges first ..
-// first + kTangentHalf - 1 on one side. Copies of a constant 8 doubles are whole vectors.
-void fill_half(TangentBlock& block, int half, const HullEllipses& e, std::size_t first, TangentSide side) {
+// first + kTangentHalf - 1 on one side, shapes scaled by scale2. Copies of a constant 8
+// doubles are whole vectors.
+void fill_half(TangentBlock& block, int half, const HullEllipses& e, std::size_t first, TangentSide side,
+               double scale2) {
   const auto copy = [&](double* lanes, const std::vector<double>& column, std::size_t from) {
     std::memcpy(lanes + half * kTangentHalf, column.data() + from, kTangentHalf * sizeof(double));
   };
+  const auto scaled = [&](double* lanes, const std::vector<double>& column, std::size_t from) {
+    for (std::size_t j = 0; j < kTangentHalf; ++j) lanes[half * kTangentHalf + j] = scale2 * column[from + j];
+  };
   copy(block.au, e.u, first), copy(block.bu, e.u, first + 1);
   copy(block.av, e.v, first), copy(block.bv, e.v, first + 1);
-  copy(block.axx, e.xx, first), copy(block.bxx, e.xx, first + 1);
-  copy(block.axy, e.xy, first), copy(block.bxy, e.xy, first + 1);
-  copy(block.ayy, e.yy, first), copy(block.byy, e.yy, first + 1);
+  scaled(block.axx, e.xx, first), scaled(block.bxx, e.xx, first + 1);
+  scaled(block.axy, e.xy, first), scaled(block.bxy, e.xy, first + 1);
+  scaled(block.ayy, e.yy, first), scaled(block.byy, e.yy, first + 1);
   std::fill_n(block.side + half * kTangentHalf, kTangentHalf, side == TangentSide::inner ? -1.0 : 1.0);
 }
 
@@ -140,7 +145,8 @@ void fill_half(TangentBlock& block, int half, const HullEllipses& e, std::size_t
 // solved twice). Past the k edges a half's lanes hold edges again from the start (the
 // ellipses repeat cyclically): real pairs, solved and not used.
 COVTRACK_VECTOR_CLONES  // the copies in whole vectors
-void hull_tangents(const HullEllipses& e, std::vector<TangentLine>* inner, std::vector<TangentLine>* outer) {
+void hull_tangents(const HullEllipses& e, double inner_scale2, double outer_scale2,
+                   std::vector<TangentLine>* inner, std::vector<TangentLine>* outer) {
   struct Half {
     std::vector<TangentLine>* lines;
     TangentSide side;
@@ -157,7 +163,10 @@ void hull_tangents(const HullEllipses& e, std::vector<TangentLine>* inner, std::
   TangentBlock block;
   for (std::size_t h = 0; h < halves.size(); h += 2) {
     const Half* pair[2] = {&halves[h], &halves[h + 1 < halves.size() ? h + 1 : h]};
-    for (int half = 0; half < 2; ++half) fill_half(block, half, e, pair[half]->first, pair[half]->side);
+    for (int half = 0; half < 2; ++half) {
+      const Half& w = *pair[half];
+      fill_half(block, half, e, w.first, w.side, w.side == TangentSide::inner ? inner_scale2 : outer_scale2);
+    }
     common_tangents(block);
     for (int half = 0; half < 2; ++half) {
       const Half& w = *pair[half];

@@ -46,25 +46,28 @@ struct TangentLine {
   bool solved;
 };
 
-// A hull's confidence ellipses as structure-of-arrays (centre u, v; shape xx, xy, yy),
+// A hull's pixel covariances as structure-of-arrays (centre u, v; covariance xx, xy, yy),
 // repeated cyclically past the k hull vertices, so that the ellipses of a block's edges
-// (a = i, b = i + 1) are whole runs, copied a vector at a time.
+// (a = i, b = i + 1) are whole runs, copied a vector at a time. Each side scales them to its
+// own confidence as they are copied: the outer region's scale is the whole object's, the
+// inner's a vertex's (regions.hpp).
 struct HullEllipses {
   std::size_t k = 0;
   std::vector<double> u, v, xx, xy, yy;
 };
 
 // The lines of every hull edge i (vertex i -> i + 1, cyclic) on each side asked for (a
-// null side is skipped). Both sides of up to 8 edges share a block.
-void hull_tangents(const HullEllipses& ellipses, std::vector<TangentLine>* inner,
-                   std::vector<TangentLine>* outer);
+// null side is skipped), the ellipses scaled by inner_scale2 and outer_scale2 (confidence
+// scales squared). Both sides of up to 8 edges share a block.
+void hull_tangents(const HullEllipses& ellipses, double inner_scale2, double outer_scale2,
+                   std::vector<TangentLine>* inner, std::vector<TangentLine>* outer);
 
 // The same from the hull's vertices: vertex(i) gives the const ProjectedVertex& of hull
-// vertex i < k; `scale2` is the confidence scale squared. A point or a segment (k < 3) has
-// no edges to give lines: the sides asked for come back empty.
+// vertex i < k. A point or a segment (k < 3) has no edges to give lines: the sides asked
+// for come back empty.
 template <class HullVertex>
-void hull_tangents(std::size_t k, HullVertex vertex, double scale2, std::vector<TangentLine>* inner,
-                   std::vector<TangentLine>* outer) {
+void hull_tangents(std::size_t k, HullVertex vertex, double inner_scale2, double outer_scale2,
+                   std::vector<TangentLine>* inner, std::vector<TangentLine>* outer) {
   if (k < 3) {
     for (auto* lines : {inner, outer})
       if (lines) lines->clear();
@@ -77,11 +80,18 @@ void hull_tangents(std::size_t k, HullVertex vertex, double scale2, std::vector<
   for (auto* column : {&e.u, &e.v, &e.xx, &e.xy, &e.yy}) column->resize(entries);
   for (std::size_t i = 0, vi = 0; i < entries; ++i, vi = vi + 1 == k ? 0 : vi + 1) {
     const ProjectedVertex& p = vertex(vi);
-    const Vec3 S = confidence_shape(p.covariance_px2, scale2);
+    const Vec3 S = confidence_shape(p.covariance_px2, 1.0);
     e.u[i] = p.mean_px.x(), e.v[i] = p.mean_px.y();
     e.xx[i] = S[0], e.xy[i] = S[1], e.yy[i] = S[2];
   }
-  hull_tangents(e, inner, outer);
+  hull_tangents(e, inner_scale2, outer_scale2, inner, outer);
+}
+
+// One side at one scale.
+template <class HullVertex>
+void hull_tangents(std::size_t k, HullVertex vertex, double scale2, std::vector<TangentLine>* inner,
+                   std::vector<TangentLine>* outer) {
+  hull_tangents(k, vertex, scale2, scale2, inner, outer);
 }
 
 inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }

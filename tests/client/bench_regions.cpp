@@ -26,10 +26,11 @@ const Frame& frame() {
 }
 
 // As an application runs it: one ObjectRegions kept per object, recomputed every frame.
-void run_frame(benchmark::State& state, ProjectionMethod method) {
+void run_frame(benchmark::State& state, ProjectionMethod method, bool whole_object = true) {
   const Frame& f = frame();
   ObjectRegionOptions o;
   o.projection.method = method;
+  o.regions.whole_object = whole_object;
   std::vector<ObjectRegions> regions(f.poses.size());
   for (auto _ : state) {
     for (std::size_t i = 0; i < f.poses.size(); ++i) {
@@ -42,6 +43,11 @@ void run_frame(benchmark::State& state, ProjectionMethod method) {
 
 void BM_FrameUnscented(benchmark::State& state) { run_frame(state, ProjectionMethod::unscented); }
 void BM_FrameLinear(benchmark::State& state) { run_frame(state, ProjectionMethod::linear); }
+// The outer region at one vertex's scale (RegionOptions::whole_object false): what the
+// whole-object scale costs.
+void BM_FrameUnscentedPerVertexScale(benchmark::State& state) {
+  run_frame(state, ProjectionMethod::unscented, false);
+}
 
 // The same regions from sample covariances of 1,000 sampled poses per object.
 void BM_FrameMonteCarlo1000(benchmark::State& state) {
@@ -147,6 +153,7 @@ void BM_FrameInnerOnly(benchmark::State& state) {
 
 BENCHMARK(BM_FrameUnscented)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameLinear)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameUnscentedPerVertexScale)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameProjectionOnlyUnscented)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameOuterOnly)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameInnerOnly)->Unit(benchmark::kMillisecond);

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -558,4 +559,48 @@ TEST(CameraFile, RosCameraInfoMistakesAreNamed) {
   ASSERT_TRUE(cam) << cam.error().message;
   EXPECT_EQ(cam->k1, 0);
   EXPECT_DOUBLE_EQ(cam->fx, 500);
+}
+
+// The depth_nonlinear threshold, by measurement: the unscented covariance's error against
+// Monte Carlo as the depth's spread grows against the depth, from the translation along the
+// line of sight and from rotation about a point far from the vertex (a long stylus pointing
+// at the camera). The default threshold must flag every case past 5% error and none under
+// 2%; the table shows where it lies.
+TEST(DepthNonlinearity, FlagsWhereTheUnscentedCovarianceErrs) {
+  const Camera cam = test::example_camera();
+  ProjectionOptions o;
+  o.add_intrinsic_uncertainty = false;
+  struct Case {
+    const char* what;
+    double depth_sigma_m, rotation_deg, lever_m;
+  };
+  std::vector<Case> cases;
+  for (double s : {0.02, 0.05, 0.08, 0.1, 0.12, 0.15, 0.2, 0.25, 0.3}) cases.push_back({"translation", s, 1, 0});
+  for (double lever : {0.3, 0.6, 0.9, 1.2, 1.5, 1.8}) cases.push_back({"rotation", 0.003, 6, lever});
+  int flagged_high = 0, high = 0, flagged_low = 0;
+  for (const Case& c : cases) {
+    // 1 m ahead, off the optical axis; the lever across the line of sight, the vertex at its
+    // end, so that rotation moves it along the line of sight.
+    Mat6 C = Mat6::Zero();
+    C.diagonal() << 0.003 * 0.003, 0.003 * 0.003, c.depth_sigma_m * c.depth_sigma_m,
+        Vec3::Constant(c.rotation_deg * kDeg * c.rotation_deg * kDeg);
+    const UncertainPose pose{pose_from(Vec3(0.2 - c.lever_m, 0.1, 1.0), Eigen::Quaterniond::Identity()), C, false};
+    const Vec3 p(c.lever_m, 0, 0);
+    const ProjectedVertex v = project_vertex(cam, pose, p, o);
+    const double error = relative_frobenius(v.covariance_px2, monte_carlo_covariance(cam, pose, p, 200'000));
+    const double ratio = v.depth_sigma_m / v.depth_m;
+    std::printf("%-11s depth sigma / depth %.3f: covariance error %.4f%s%s\n", c.what, ratio, error,
+                v.flags.depth_nonlinear ? "  [depth_nonlinear]" : "", v.flags.usable() ? "" : " (unusable)");
+    if (error > 0.05) {
+      ++high;
+      flagged_high += v.flags.depth_nonlinear;
+      EXPECT_TRUE(v.flags.depth_nonlinear) << c.what << " " << ratio << ": error " << error;
+    }
+    if (error < 0.02) {
+      flagged_low += v.flags.depth_nonlinear;
+      EXPECT_FALSE(v.flags.depth_nonlinear) << c.what << " " << ratio << ": error " << error;
+    }
+  }
+  EXPECT_GT(high, 0) << "no case reached 5%: the table does not show where the threshold lies";
+  std::printf("flagged: %d of %d cases past 5%%, %d under 2%%\n", flagged_high, high, flagged_low);
 }

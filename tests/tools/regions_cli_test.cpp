@@ -35,6 +35,22 @@ const nlohmann::json& object(const nlohmann::json& doc, const std::string& name)
   return none;
 }
 
+// `covtrack regions --json` on a scene written here: the example camera and a 20 cm box in
+// frame "thing", placed by `transform` (the [[transform]] table's position and sigmas).
+nlohmann::json run_one_object_scene(const std::string& file_name, const std::string& transform) {
+  const std::filesystem::path scene = std::filesystem::temp_directory_path() / file_name;
+  std::ofstream(scene) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR
+                          "/config/cameras/example_640x480.yml\"\n"
+                          "[[transform]]\nparent = \"camera\"\nchild = \"thing\"\n"
+                       << transform << "[[object]]\nname = \"box\"\nframe = \"thing\"\nbox_m = [0.2, 0.2, 0.2]\n";
+  const CliRun r = run(scene.string() + " --json");
+  std::filesystem::remove(scene);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  const nlohmann::json doc = nlohmann::json::parse(r.out, nullptr, false);
+  EXPECT_FALSE(doc.is_discarded()) << r.out;
+  return doc;
+}
+
 }  // namespace
 
 TEST(RegionsCli, JsonDescribesEveryHullVertexAndConsistentRegions) {
@@ -131,21 +147,28 @@ TEST(RegionsCli, EveryShippedSceneGivesARegionForEveryObject) {
 }
 
 TEST(RegionsCli, ObjectBehindTheCameraIsFlaggedNotProjected) {
-  const std::filesystem::path scene = std::filesystem::temp_directory_path() / "covtrack_behind.toml";
-  std::ofstream(scene) << "[camera]\nframe = \"camera\"\ncalibration = \"" COVTRACK_SOURCE_DIR
-                          "/config/cameras/example_640x480.yml\"\n"
-                          "[[transform]]\nparent = \"camera\"\nchild = \"thing\"\nposition_m = [0, 0, -2]\n"
-                          "sigma_m = [0.01, 0.01, 0.01]\nsigma_rad = [0.01, 0.01, 0.01]\n"
-                          "[[object]]\nname = \"behind\"\nframe = \"thing\"\nbox_m = [0.2, 0.2, 0.2]\n";
-  const CliRun r = run(scene.string() + " --json");
-  std::filesystem::remove(scene);
-  ASSERT_EQ(r.exit_code, 0) << r.out;
-  const nlohmann::json doc = nlohmann::json::parse(r.out, nullptr, false);
-  ASSERT_FALSE(doc.is_discarded()) << r.out;
+  const nlohmann::json doc = run_one_object_scene("covtrack_behind.toml", "position_m = [0, 0, -2]\n"
+                                                  "sigma_m = [0.01, 0.01, 0.01]\nsigma_rad = [0.01, 0.01, 0.01]\n");
   const auto& o = doc["objects"][0];
   EXPECT_FALSE(o["valid"].get<bool>());
   EXPECT_TRUE(o["assessment_px"].is_null());
   EXPECT_EQ(o["flags"], nlohmann::json::array({"behind_camera"}));
   EXPECT_TRUE(o["outer_px"].empty());
   for (const auto& v : o["vertices"]) EXPECT_TRUE(v["mean_px"].is_null());
+}
+
+// Depth known to 10% of the distance (a monocular tracker's range, say): the ellipses are
+// still drawn, and every vertex and the object say that their shape is in doubt. (The
+// shipped scenes above carry no flag.)
+TEST(RegionsCli, DepthSpreadLargeAgainstTheDepthIsFlagged) {
+  const nlohmann::json doc = run_one_object_scene("covtrack_depth_spread.toml", "position_m = [0, 0, 1.5]\n"
+                                                  "sigma_m = [0.005, 0.005, 0.15]\nsigma_rad = [0.01, 0.01, 0.01]\n");
+  const auto& o = doc["objects"][0];
+  EXPECT_TRUE(o["valid"].get<bool>());
+  EXPECT_EQ(o["flags"], nlohmann::json::array({"depth_nonlinear"}));
+  EXPECT_FALSE(o["outer_px"].empty());
+  for (const auto& v : o["vertices"]) {
+    EXPECT_GT(v["depth_sigma_m"].get<double>(), 0.07 * v["depth_m"].get<double>());
+    EXPECT_EQ(v["flags"], nlohmann::json::array({"depth_nonlinear"}));
+  }
 }

@@ -44,6 +44,7 @@ nlohmann::json object_json(const RegionsReport::Object& o) {
                              {"mean_px", nullptr},
                              {"covariance_px2", nullptr},
                              {"depth_m", v.depth_m},
+                             {"depth_sigma_m", v.depth_sigma_m},
                              {"flags", flag_names(v.flags)}};
     if (v.flags.usable()) {  // otherwise there is no pixel, or no covariance, to give
       vertex["mean_px"] = {v.mean_px.x(), v.mean_px.y()};
@@ -59,6 +60,7 @@ nlohmann::json object_json(const RegionsReport::Object& o) {
           {"flags", flag_names(o.regions.flags)},
           {"vertices", vertices},
           {"screen_hull", o.regions.hull},
+          {"outer_scale", o.regions.outer_scale},
           {"outer_px", polygon_json(o.regions.outer)},
           {"inner_px", polygon_json(o.regions.inner)}};
 }
@@ -90,7 +92,8 @@ void print_text(const RegionsReport& report) {
                  i, v.mean_px.x(), v.mean_px.y(), c(0, 0), c(0, 1), c(1, 0), c(1, 1), v.depth_m);
     }
     if (!r.valid) continue;
-    fmt::print("  outer ({} points):{}\n", r.outer.size(), polygon_text(r.outer));
+    fmt::print("  outer ({} points, ellipses at {:.2f} sigma: the whole object at {:.0f}%):{}\n", r.outer.size(),
+               r.outer_scale, 100 * report.confidence, polygon_text(r.outer));
     if (r.hull.size() < 3)
       fmt::print("  inner: none (the object covers no area on the screen)\n");
     else if (r.inner.empty())

@@ -53,6 +53,9 @@ struct UnscentedParams {
 
 enum class ProjectionMethod { unscented, linear };
 
+// ProjectionOptions::max_depth_sigma_ratio's default (see there).
+inline constexpr double kDefaultMaxDepthSigmaRatio = 0.07;
+
 struct ProjectionOptions {
   ProjectionMethod method = ProjectionMethod::unscented;
   UnscentedParams unscented;
@@ -63,6 +66,13 @@ struct ProjectionOptions {
   double max_rotation_sigma_rad = 15.0 * std::numbers::pi / 180.0;
   // Add the camera's intrinsic sigmas (first order) to the screen covariance.
   bool add_intrinsic_uncertainty = true;
+  // Above this depth sigma over depth (ProjectedVertex::depth_sigma_m / depth_m), the
+  // perspective division bends too much over the vertex's spread along the line of sight
+  // for a Gaussian through the unscented transform (or a linearisation) to describe its
+  // pixel: flagged depth_nonlinear. Chosen by measurement (projection_test.cpp,
+  // DepthNonlinearity): there the unscented covariance's error against Monte Carlo
+  // passes 5%.
+  double max_depth_sigma_ratio = kDefaultMaxDepthSigmaRatio;
 };
 
 struct ProjectionFlags {
@@ -74,6 +84,10 @@ struct ProjectionFlags {
   // The vertex, or one of its sigma points, lies past the lens model's distortion fold
   // (Camera::distortion_fold_r2): its pixel is not where the point appears.
   bool past_distortion_fold = false;
+  // The vertex's depth spread along the line of sight is a large fraction of its depth
+  // (ProjectionOptions::max_depth_sigma_ratio): the ellipse is an approximation to doubt.
+  // A warning: the regions are still computed.
+  bool depth_nonlinear = false;
 
   // The mean and covariance describe the vertex (the other flags are warnings).
   bool usable() const {
@@ -81,7 +95,7 @@ struct ProjectionFlags {
   }
   bool any() const {
     return behind_camera || sigma_point_behind_camera || rotation_too_uncertain ||
-           unbounded || covariance_repaired || past_distortion_fold;
+           unbounded || covariance_repaired || past_distortion_fold || depth_nonlinear;
   }
   // Inline: it runs for every vertex of every object, and a call cost more than the ors.
   ProjectionFlags& operator|=(const ProjectionFlags& o) {
@@ -91,6 +105,7 @@ struct ProjectionFlags {
     unbounded |= o.unbounded;
     covariance_repaired |= o.covariance_repaired;
     past_distortion_fold |= o.past_distortion_fold;
+    depth_nonlinear |= o.depth_nonlinear;
     return *this;
   }
 };
@@ -99,6 +114,9 @@ struct ProjectedVertex {
   Vec2 mean_px = Vec2::Zero();
   Mat2 covariance_px2 = Mat2::Zero();
   double depth_m = 0;  // camera z of the unperturbed vertex
+  // Standard deviation of the camera z under the pose's error (the unscented transform's,
+  // or first order); 0 without a covariance.
+  double depth_sigma_m = 0;
   ProjectionFlags flags;
 };
 

@@ -9,8 +9,11 @@
 //    of the ellipse; N is the smallest count meeting RegionOptions::max_polygon_error_px.
 //  - Outer region (expansion, 5.5.1): the convex hull of the ellipses, as the
 //    intersection of its support half-planes {n . x <= h(n)}, h(n) = max over the ellipses
-//    of n . c + sqrt(n^T S n). It contains every ellipse, so each vertex lies in it with
-//    probability >= p. Directions start 45 degrees apart; a gap is split while the corner
+//    of n . c + sqrt(n^T S n). compute_object_regions scales the ellipses by the whole
+//    object's quantile (whole_object_scale2), so that the WHOLE object, every vertex and
+//    edge at once, lies in it with probability >= p (docs/regions.md: the argument and the
+//    Monte Carlo checks); at one vertex's scale (expand_region alone, or
+//    RegionOptions::whole_object false) each vertex alone does. Directions start 45 degrees apart; a gap is split while the corner
 //    of its two lines is farther than max_polygon_error_px from the chord between their
 //    contact points and, when one ellipse touches both lines, from that ellipse's point
 //    facing the corner (both lie inside the hull), so every corner, hence every point of
@@ -79,7 +82,29 @@ struct RegionOptions {
   // (region_outer.cpp); the general search otherwise, or always when false. Both give the
   // guarantee above; the shortcut is about 1.4x faster on typical objects.
   bool outer_by_arcs = true;
+  // compute_object_regions: scale the outer region so that it holds the WHOLE object with
+  // probability >= confidence (whole_object_scale2); false: each vertex's ellipse at the
+  // confidence, which holds each vertex alone (a whole object only in fewer draws).
+  bool whole_object = true;
 };
+
+// ---- The outer region's scale for a whole object (region_scale.cpp) ----
+// The quantile of a chi-square distribution with 6 degrees of freedom (the pose's).
+double chi2_6_quantile(double probability);
+// The squared confidence scale of the outer region of an object whose mean hull (indices
+// into `projected`, counter-clockwise) is mean_hull, so that the hull of every vertex's
+// ellipse at this scale holds every point of the object at once with probability >= the
+// confidence: a simultaneous bound. Between the one-point value chi2_2(p) = -2 ln(1 - p)
+// (a point, or vertices moving together) and chi2_6(p) (the pose's own confidence
+// ellipsoid, which maps inside every point's ellipse at that scale):
+//     2 ln(L / (2 pi (1 - p))),
+// L the length of the curve that the hull vertices' whitened error directions trace
+// round the region (region_scale.cpp), 2 pi for a point. First order in the pose, from
+// the mean pose's Jacobians (pixel_jacobian_wrt_perturbation) and the projected
+// covariances.
+double whole_object_scale2(const Camera& camera, const UncertainPose& T_camera_object,
+                           std::span<const Vec3> vertices_object, std::span<const ProjectedVertex> projected,
+                           std::span<const int> mean_hull, double confidence);
 
 // ---- Expansion and contraction (regions.cpp) ----
 Polygon expand_region(std::span<const ProjectedVertex> vertices, const RegionOptions& options);
@@ -106,6 +131,9 @@ struct ObjectRegions {
   std::vector<ProjectedVertex> vertices;  // one per input vertex, same order
   std::vector<int> hull;                  // indices of the mean hull, counter-clockwise
   Polygon outer;                          // empty when !valid
+  // The confidence scale of the outer region's ellipses (sqrt of whole_object_scale2, or
+  // of chi2_2(p) without RegionOptions::whole_object); 0 when !valid.
+  double outer_scale = 0;
   Polygon inner;                          // empty when !valid or swamped by the error
   double assessment = 0;                  // of the hull vertices; +inf when !valid
   ProjectionFlags flags;                  // OR over all vertices

@@ -1,0 +1,160 @@
+// The outer region's confidence scale for a whole object: a simultaneous bound over every
+// point of the object, not one vertex's (regions.hpp says what it guarantees).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include "covtrack/client/regions.hpp"
+#include "vector_clones.hpp"
+
+namespace covtrack::client {
+
+namespace {
+
+// Edges solved side by side: loops of fixed length without branches over structure-of-
+// arrays data, which vectorise (vector_clones.hpp), as the projection's blocks do.
+constexpr std::size_t kLanes = 8;
+
+// An upper bound, within 0.01 rad, of the angle atan2(y, x) in [0, pi] for y >= 0, without
+// trigonometry: 2 atan(t) for the half angle's tangent t, with atan(t) within
+// 0.005 rad of t / (1 + 0.28125 t^2) for t <= 1, of pi/2 - t / (t^2 + 0.28125) beyond.
+inline double angle_at_most(double y, double x) {
+  const double r = std::sqrt(x * x + y * y);
+  // t = y / (r + x) = (r - x) / y, the first where x >= 0, the second (capped: y may be 0,
+  // opposite directions, pi) where x < 0: neither divides by a small difference.
+  const double t = x >= 0 ? y / std::max(r + x, 1e-300) : std::min((r - x) / y, 1e300);
+  const double half = t <= 1 ? t / (1 + 0.28125 * t * t) : std::numbers::pi / 2 - t / (t * t + 0.28125);
+  return std::min(2 * (half + 0.005), std::numbers::pi);
+}
+
+// A block of hull edges: lane l holds hull vertex first + l (cyclic) and the edge that
+// starts there; lane kLanes only the last edge's end. Per vertex the object point, the
+// pixel covariance (xx, xy, yy) and the outward normal of its edge; then M, the pixel's
+// derivative by the object-frame point (2x3, rows m0, m1). Fixed arrays, so that the
+// compiler sees that they do not overlap.
+struct EdgeBlock {
+  double px[kLanes + 1], py[kLanes + 1], pz[kLanes + 1], sxx[kLanes + 1], sxy[kLanes + 1], syy[kLanes + 1];
+  double u[kLanes + 2], v[kLanes + 2];  // mean pixels, one more: the normal of lane kLanes's edge
+  double nx[kLanes + 1], ny[kLanes + 1];
+  double m00[kLanes + 1], m01[kLanes + 1], m02[kLanes + 1], m10[kLanes + 1], m11[kLanes + 1], m12[kLanes + 1];
+  double length[kLanes];
+};
+
+// Each edge's jump and its end vertex's arc (see whole_object_scale2), into length[e]. M is
+// the pinhole's, up to a factor per vertex (1 / depth), which no angle depends on; the
+// lens's distortion bends directions only by its local anisotropy, small inside its fold.
+COVTRACK_VECTOR_CLONES
+void edge_lengths(const double (&C)[36], const double (&R)[9], const double (&t)[3], double fx, double fy,
+                  EdgeBlock& h) {
+  for (std::size_t l = 0; l <= kLanes; ++l) {
+    const double du = h.u[l + 1] - h.u[l], dv = h.v[l + 1] - h.v[l], d2 = du * du + dv * dv;
+    const double inverse = d2 > 0 ? 1 / std::sqrt(d2) : 0.0;  // no edge: no normal, no angle
+    h.nx[l] = dv * inverse, h.ny[l] = -du * inverse;
+    const double x = R[0] * h.px[l] + R[1] * h.py[l] + R[2] * h.pz[l] + t[0];
+    const double y = R[3] * h.px[l] + R[4] * h.py[l] + R[5] * h.pz[l] + t[1];
+    const double z = R[6] * h.px[l] + R[7] * h.py[l] + R[8] * h.pz[l] + t[2];
+    const double xn = x / z, yn = y / z;
+    h.m00[l] = fx * (R[0] - xn * R[6]), h.m01[l] = fx * (R[1] - xn * R[7]), h.m02[l] = fx * (R[2] - xn * R[8]);
+    h.m10[l] = fy * (R[3] - yn * R[6]), h.m11[l] = fy * (R[4] - yn * R[7]), h.m12[l] = fy * (R[5] - yn * R[8]);
+  }
+  for (std::size_t e = 0; e < kLanes; ++e) {
+    const std::size_t f = e + 1;
+    const double nx = h.nx[e], ny = h.ny[e];
+    // J^T n = [w, p x w] with w = M^T n, for the edge's two vertices.
+    const double wa[3] = {nx * h.m00[e] + ny * h.m10[e], nx * h.m01[e] + ny * h.m11[e], nx * h.m02[e] + ny * h.m12[e]};
+    const double wb[3] = {nx * h.m00[f] + ny * h.m10[f], nx * h.m01[f] + ny * h.m11[f], nx * h.m02[f] + ny * h.m12[f]};
+    const double a[6] = {wa[0], wa[1], wa[2], h.py[e] * wa[2] - h.pz[e] * wa[1], h.pz[e] * wa[0] - h.px[e] * wa[2],
+                         h.px[e] * wa[1] - h.py[e] * wa[0]};
+    const double b[6] = {wb[0], wb[1], wb[2], h.py[f] * wb[2] - h.pz[f] * wb[1], h.pz[f] * wb[0] - h.px[f] * wb[2],
+                         h.px[f] * wb[1] - h.py[f] * wb[0]};
+    double aa = 0, ab = 0, bb = 0;
+#pragma GCC unroll 6
+    for (int r = 0; r < 6; ++r) {
+      double Ca = 0, Cb = 0;
+#pragma GCC unroll 6
+      for (int c = 0; c < 6; ++c) Ca += C[6 * r + c] * a[c], Cb += C[6 * r + c] * b[c];
+      aa += a[r] * Ca, ab += b[r] * Ca, bb += b[r] * Cb;
+    }
+    // (No jump where a vertex does not move along the normal: aa bb = 0 gives the angle 0.)
+    const double jump = angle_at_most(std::sqrt(std::max(aa * bb - ab * ab, 0.0)), std::max(aa * bb, 0.0) > 0 ? ab : 1.0);
+    // Vertex e + 1's arc from this edge's normal to the next edge's, in its covariance's metric.
+    const double mx = h.nx[f], my = h.ny[f];
+    const double turn = std::abs(nx * my - ny * mx);
+    const double det = h.sxx[f] * h.syy[f] - h.sxy[f] * h.sxy[f];
+    const double dot = nx * (h.sxx[f] * mx + h.sxy[f] * my) + ny * (h.sxy[f] * mx + h.syy[f] * my);
+    h.length[e] = jump + angle_at_most(std::sqrt(std::max(det, 0.0)) * turn, dot);
+  }
+}
+
+}  // namespace
+
+double chi2_6_quantile(double p) {
+  // Every object asks for the same confidence: remember the last one.
+  thread_local double last_p = std::numeric_limits<double>::quiet_NaN(), last_x = 0;
+  if (p == last_p) return last_x;
+  // With six degrees of freedom, P(X > x) = exp(-x/2) (1 + x/2 + x^2/8): Newton on its
+  // logarithm, which is close to linear in x; from the two-dimensional quantile plus 4.
+  const double target = std::log1p(-p);
+  double x = -2 * std::log1p(-p) + 4;
+  for (int it = 0; it < 50; ++it) {
+    const double poly = 1 + x / 2 + x * x / 8;
+    const double f = -x / 2 + std::log(poly) - target;
+    const double df = -0.5 + (0.5 + x / 4) / poly;
+    const double step = f / df;
+    x = std::max(x - step, 1e-12);
+    if (std::abs(step) <= 1e-12 * x) break;
+  }
+  last_p = p;
+  last_x = x;
+  return x;
+}
+
+double whole_object_scale2(const Camera& camera, const UncertainPose& pose,
+                           std::span<const Vec3> vertices_object, std::span<const ProjectedVertex> projected,
+                           std::span<const int> mean_hull, double confidence) {
+  // Whitened by the pose covariance C, each hull vertex i facing the direction n (a unit
+  // normal on the screen) is the unit vector u_i(n) along C^(1/2) J_i^T n in R^6 (J_i its
+  // pixel Jacobian), and the object leaves the region along n when u . z > scale for the
+  // pose's standard normal z. Round the region's boundary u traces a closed curve: over
+  // vertex i's arc (normals between its two hull edges') a piece of a great circle, as long
+  // as the arc's turn measured in vertex i's own covariance; at an edge, a jump to the next
+  // vertex's u, bridged here by the great circle between them (more directions: only
+  // conservative). The chance that the largest u . z on a closed curve of length L exceeds
+  // s is at most about its expected count of upcrossings, L / (2 pi) exp(-s^2 / 2) (Rice's
+  // formula; exact for one point, whose curve is a whole great circle, L = 2 pi). Vertices
+  // inside the mean hull are not on the curve: to leave the region they must move farther.
+  const double per_vertex = -2 * std::log1p(-confidence);
+  const std::size_t k = mean_hull.size();
+  if (k < 2) return per_vertex;  // one point: the region is its ellipse
+  double C[36];
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) C[6 * r + c] = pose.covariance(r, c);
+  double R[9], t[3];
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R[3 * r + c] = pose.T.linear()(r, c);
+    t[r] = pose.T.translation()[r];
+  }
+  EdgeBlock h;
+  double length = 0;
+  for (std::size_t first = 0; first < k; first += kLanes) {
+    for (std::size_t l = 0, i = first % k; l <= kLanes + 1; ++l, i = i + 1 == k ? 0 : i + 1) {
+      const ProjectedVertex& pv = projected[mean_hull[i]];
+      h.u[l] = pv.mean_px.x(), h.v[l] = pv.mean_px.y();
+      if (l > kLanes) break;
+      const Vec3& p = vertices_object[mean_hull[i]];
+      h.px[l] = p.x(), h.py[l] = p.y(), h.pz[l] = p.z();
+      const Mat2& S = pv.covariance_px2;
+      h.sxx[l] = S(0, 0), h.sxy[l] = 0.5 * (S(0, 1) + S(1, 0)), h.syy[l] = S(1, 1);
+    }
+    edge_lengths(C, R, t, camera.fx, camera.fy, h);
+    for (std::size_t l = 0; l < kLanes && first + l < k; ++l) length += h.length[l];
+  }
+  const double s2 = 2 * std::log(std::max(length, 2 * std::numbers::pi) / (2 * std::numbers::pi)) + per_vertex;
+  // Never beyond the bound that holds for every point at once: the 6-D confidence
+  // ellipsoid of the pose maps inside every point's ellipse at that scale.
+  return std::min(s2, chi2_6_quantile(confidence));
+}
+
+}  // namespace covtrack::client
