@@ -150,9 +150,9 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
   EXPECT_GE(detected, static_cast<int>(calibration.size()) * kDraws * 9 / 10);
   const CornerNoiseModel model = fit_corner_noise(views, draws);
   print_views(calibration, draws, model);
-  std::printf("calibrated: gain %.4f, floor %.4f, aligned %.4f, shift %.4f (falloff %.2f, sigma %.4f), "
+  std::printf("calibrated: gain %.4f, floor %.4f, sample floor %.4f, aligned %.4f, shift %.4f (falloff %.2f, sigma %.4f), "
               "scale bias %.4f/px blur, scale %.4f + %.4f/px blur, edge %.4f + %.4f/px blur, tilt %.4f + %.4f/px blur\n",
-              model.gain_px, model.floor_px, model.aligned_px, model.shift_px, model.shift_falloff,
+              model.gain_px, model.floor_px, model.sample_floor_px, model.aligned_px, model.shift_px, model.shift_falloff,
               model.shift_sigma_px, model.scale_bias_per_blur, model.scale_sigma_px, model.scale_per_blur,
               model.edge_sigma_px, model.edge_per_blur, model.tilt_sigma_px, model.tilt_per_blur);
   // The shipped defaults must be this calibration's
@@ -162,6 +162,7 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
     return std::abs(fitted - default_value) <= 0.001 + 0.05 * std::abs(default_value);
   };
   EXPECT_TRUE(near(model.gain_px, shipped.gain_px) && near(model.floor_px, shipped.floor_px) &&
+              near(model.sample_floor_px, shipped.sample_floor_px) &&
               near(model.aligned_px, shipped.aligned_px) && near(model.shift_px, shipped.shift_px) &&
               near(model.shift_sigma_px, shipped.shift_sigma_px) &&
               near(model.scale_bias_per_blur, shipped.scale_bias_per_blur) &&
