@@ -1,8 +1,10 @@
 // The serial 6-DOF driver against its emulators over real pseudo-terminals: the
 // configuration sequence per protocol, NEES of the reported covariance against the
 // emulator's truth, trouble flags, units, and the port going away and coming back.
-// The tests that time how soon a silent unit is reported LOST run driver and emulator on
-// a simulated clock (manual_clock.hpp), so that a loaded machine cannot make them late.
+// Driver and emulator run on a simulated clock (manual_clock.hpp) wherever they stream:
+// a loaded machine cannot make a LOST report late or stall the emulator into a burst that
+// the motion gate would see as a jump, and thousands of records take a fraction of a
+// second instead of their real duration.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -155,9 +157,11 @@ TEST_P(Serial6dofDriverNees, ReportedCovarianceMatchesTheErrorsAgainstTruth) {
   const std::vector<int> stations = {1, 2};
   const std::string name = std::string(model_spec(model).name);
   const double rate_hz = 200;  // faster than most of these units, to keep the test short
-  Rig rig = make_rig(model, stations, name, /*trouble_every_s=*/0.05, rate_hz);
+  test::ManualClock clock;
+  Rig rig = make_rig(model, stations, name, /*trouble_every_s=*/0.05, rate_hz, {}, &clock);
   test::CaptureSink sink;
-  auto result = run_for_samples(sink, driver_config(model, stations, rig.emulator->device_path(), rate_hz), 1500);
+  auto result =
+      run_for_samples(sink, driver_config(model, stations, rig.emulator->device_path(), rate_hz), 1500, 0, &clock);
   EXPECT_TRUE(result) << result.error().message;
   const auto s = nees(sink, rig);
   ASSERT_GE(s.n, 1500) << "errors: " << sink.errors;
@@ -189,13 +193,17 @@ TEST_P(Serial6dofLineNoise, CorruptRecordsNeverBecomeConfidentPoses) {
   const Model model = GetParam();
   const std::string name = "noise_" + std::string(model_spec(model).name);
   const double rate_hz = 240;
-  Rig rig = make_rig(model, {1, 2}, name, 0, rate_hz, [](emulate6dof::EmulatorConfig& c) {
-    c.bit_flips_per_s = 120;
-    c.bytes_dropped_per_s = 10;
-    c.bytes_duplicated_per_s = 10;
-  });
+  test::ManualClock clock;
+  Rig rig = make_rig(
+      model, {1, 2}, name, 0, rate_hz,
+      [](emulate6dof::EmulatorConfig& c) {
+        c.bit_flips_per_s = 120;
+        c.bytes_dropped_per_s = 10;
+        c.bytes_duplicated_per_s = 10;
+      },
+      &clock);
   test::CaptureSink sink;
-  (void)run_for_samples(sink, driver_config(model, {1, 2}, rig.emulator->device_path(), rate_hz), 6000);
+  (void)run_for_samples(sink, driver_config(model, {1, 2}, rig.emulator->device_path(), rate_hz), 6000, 0, &clock);
   const auto s = nees(sink, rig);
   std::cout << "[ line noise ] " << model_spec(model).name << ": " << rig.emulator->noise_events()
             << " noise events, " << s.n << " poses published (" << s.degraded << " degraded), "
@@ -210,13 +218,18 @@ TEST_P(Serial6dofLineNoise, CorruptRecordsNeverBecomeConfidentPoses) {
 TEST(Serial6dofDriver, TheGateDropsNothingFromACleanMovingStream) {
   // Receivers swaying like a hand (0.15 m and 0.4 rad at 0.7-1.2 Hz: up to 1.1 m/s).
   const double rate_hz = 240;
-  Rig rig = make_rig(Model::Liberty, {1, 2}, "sway", 0, rate_hz, [](emulate6dof::EmulatorConfig& c) {
-    c.sway_m = 0.15;
-    c.sway_rad = 0.4;
-    c.sway_hz = 0.7;
-  });
+  test::ManualClock clock;
+  Rig rig = make_rig(
+      Model::Liberty, {1, 2}, "sway", 0, rate_hz,
+      [](emulate6dof::EmulatorConfig& c) {
+        c.sway_m = 0.15;
+        c.sway_rad = 0.4;
+        c.sway_hz = 0.7;
+      },
+      &clock);
   test::CaptureSink sink;
-  (void)run_for_samples(sink, driver_config(Model::Liberty, {1, 2}, rig.emulator->device_path(), rate_hz), 3000);
+  (void)run_for_samples(sink, driver_config(Model::Liberty, {1, 2}, rig.emulator->device_path(), rate_hz), 3000, 0,
+                        &clock);
   int published = 0, degraded = 0;
   for (const auto& p : sink.poses) {
     published += p.status != TrackingStatus::Lost;
@@ -234,11 +247,12 @@ INSTANTIATE_TEST_SUITE_P(EachProtocol, Serial6dofLineNoise,
 
 TEST(Serial6dofDriver, InchesAreConfirmedAndConvertedToo) {
   for (Model model : {Model::Fastrak, Model::Liberty}) {
-    Rig rig = make_rig(model, {1}, std::string("inches_") + std::string(model_spec(model).name));
+    test::ManualClock clock;
+    Rig rig = make_rig(model, {1}, std::string("inches_") + std::string(model_spec(model).name), 0, 0, {}, &clock);
     auto c = driver_config(model, {1}, rig.emulator->device_path());
     c.units = Units::Inches;
     test::CaptureSink sink;
-    EXPECT_TRUE(run_for_samples(sink, c, 300));
+    EXPECT_TRUE(run_for_samples(sink, c, 300, 0, &clock));
     const auto s = nees(sink, rig);
     ASSERT_GE(s.n, 300);
     EXPECT_NEAR(s.mean, 6.0, nees_bound(s.n)) << "a units mix-up would be 2.54x off";

@@ -1,15 +1,17 @@
 // The simulated tracker's covariance is honest: NEES of its reports against its own
-// truth has the chi-square(6) mean.
+// truth has the chi-square(6) mean. The driver runs on simulated time (manual_clock.hpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
-#include <numeric>
 #include <cmath>
+#include <numeric>
 #include <thread>
 
 #include "capture_sink.hpp"
 #include "covtrack/devices/sim/sim_driver.hpp"
+#include "manual_clock.hpp"
 
 using namespace covtrack;
 
@@ -29,20 +31,30 @@ sim::SimConfig read_ok(const std::string& toml_text) {
   return c;
 }
 
-// Runs the driver until it has produced at least `samples` poses.
-void run_until(test::CaptureSink& sink, const sim::SimConfig& config, std::size_t samples) {
-  auto driver = sim::make_sim_driver(config, 0);
+// Runs the driver on simulated time until it has produced at least `samples` poses, or
+// returned. The clock's steps (1 ms) stay under the driver's backlog limit of 10
+// periods at these rates, so that no tick is skipped as if the machine had stalled.
+Result<void> run_until(test::CaptureSink& sink, const sim::SimConfig& config, std::size_t samples) {
+  test::ManualClock clock(std::chrono::milliseconds(1));
+  auto driver = sim::make_sim_driver(config, 0, clock);
   std::stop_source stop;
-  std::thread t([&] { EXPECT_TRUE(driver->run(sink, stop.get_token())); });
-  for (int i = 0; i < 1000; ++i) {
-    {
-      std::lock_guard l(sink.m);
-      if (sink.poses.size() >= samples) break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  std::atomic<bool> returned = false;
+  Result<void> result;
+  clock.join();
+  std::thread t([&] {
+    result = driver->run(sink, stop.get_token());
+    returned = true;
+    clock.leave();
+  });
+  EXPECT_TRUE(clock.run_until(
+      [&] {
+        std::lock_guard l(sink.m);
+        return returned || sink.poses.size() >= samples;
+      },
+      std::chrono::seconds(30)));
   stop.request_stop();
   t.join();
+  return result;
 }
 
 // NEES of every OK report against the truth of the same time.
@@ -99,7 +111,7 @@ TEST(SimDriver, NeesOfDiagonalCovarianceIsChiSquare6) {
     kind = "circle"
   )");
   test::CaptureSink sink;
-  run_until(sink, config, 4000);
+  ASSERT_TRUE(run_until(sink, config, 4000));
   const Nees n = nees(sink, config.covariance);
   ASSERT_GE(n.count, 2000u);
   EXPECT_TRUE(inside_99(n)) << "mean NEES " << n.mean << " over " << n.count;
@@ -124,7 +136,7 @@ TEST(SimDriver, NeesOfFullCorrelatedCovarianceIsChiSquare6) {
     kind = "random_walk"
   )");
   test::CaptureSink sink;
-  run_until(sink, config, 6000);
+  ASSERT_TRUE(run_until(sink, config, 6000));
   const Nees n = nees(sink, config.covariance);
   ASSERT_GE(n.count, 2000u);
   EXPECT_TRUE(inside_99(n)) << "mean NEES " << n.mean << " over " << n.count;
@@ -145,7 +157,7 @@ TEST(SimDriver, DropoutsReportLostWithInfiniteUncertainty) {
     dropout_duration_s = 0.05
   )");
   test::CaptureSink sink;
-  run_until(sink, config, 1000);
+  ASSERT_TRUE(run_until(sink, config, 1000));
   std::size_t lost = 0;
   for (const auto& p : sink.poses)
     lost += p.status == TrackingStatus::Lost;  // the sink checks each one's covariance
@@ -163,8 +175,7 @@ TEST(SimDriver, InjectedFailureEndsTheRunWithAnError) {
     inject_failure_every_s = 0.05
   )");
   test::CaptureSink sink;
-  auto driver = sim::make_sim_driver(config, 0);
-  const auto result = driver->run(sink, std::stop_token{});
+  const auto result = run_until(sink, config, 1'000'000);
   ASSERT_FALSE(result);
   EXPECT_NE(result.error().message.find("injected failure"), std::string::npos);
   EXPECT_NEAR(static_cast<double>(sink.poses.size()), 50, 2);
@@ -184,7 +195,7 @@ TEST(SimDriver, EveryMotionStaysNearItsCentre) {
       waypoints_m = [0.5, 2, 3,  1.5, 2, 3,  1, 2.5, 3]
       kind = ")") + kind + "\"\n");
     test::CaptureSink sink;
-    run_until(sink, config, 400);
+    ASSERT_TRUE(run_until(sink, config, 400));
     ASSERT_GE(sink.truths.size(), 400u);
     for (const auto& t : sink.truths) {
       const double d = (t.T_parent_child.translation() - Vec3(1, 2, 3)).norm();

@@ -7,9 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/interruptible_sleep.hpp"
 #include "covtrack/devices/sim/se3_gaussian.hpp"
-#include "covtrack/protocol/clock.hpp"
 #include "motion.hpp"
 
 namespace covtrack::sim {
@@ -21,8 +19,9 @@ constexpr std::uint64_t kMaxBacklogTicks = 10;
 
 class SimDriver final : public Driver {
  public:
-  SimDriver(const SimConfig& config, std::uint64_t run_index)
+  SimDriver(const SimConfig& config, std::uint64_t run_index, DriverClock& clock)
       : config_(config),
+        clock_(clock),
         noise_(config.covariance),
         rng_(config.seed + 0x9E3779B97F4A7C15ull * run_index),
         motion_(config.motion, config.seed ^ 0x5151u),
@@ -31,13 +30,13 @@ class SimDriver final : public Driver {
   Result<void> run(SampleSink& sink, std::stop_token stop) override {
     using namespace std::chrono;
     const double period_s = 1.0 / config_.rate_hz;
-    const auto period = duration_cast<steady_clock::duration>(duration<double>(period_s));
-    const auto start = steady_clock::now();
-    const std::int64_t start_us = now_us();
+    const auto period = duration_cast<DriverClock::duration>(duration<double>(period_s));
+    const auto start = clock_.now();
+    const std::int64_t start_us = clock_.now_us();
 
     for (std::uint64_t tick = 0;; ++tick) {
-      if (!sleep_until(stop, start + tick * period)) return {};
-      const auto behind = (steady_clock::now() - start) / period;
+      if (!clock_.sleep_until(stop, start + tick * period)) return {};
+      const auto behind = (clock_.now() - start) / period;
       if (behind > static_cast<std::int64_t>(tick + kMaxBacklogTicks)) {
         for (auto skipped = tick; skipped < static_cast<std::uint64_t>(behind); ++skipped)
           sink.count_drop();
@@ -80,6 +79,7 @@ class SimDriver final : public Driver {
   }
 
   SimConfig config_;
+  DriverClock& clock_;
   Se3Gaussian noise_;
   std::mt19937_64 rng_;
   Motion motion_;
@@ -88,8 +88,8 @@ class SimDriver final : public Driver {
 
 }  // namespace
 
-std::unique_ptr<Driver> make_sim_driver(const SimConfig& config, std::uint64_t run_index) {
-  return std::make_unique<SimDriver>(config, run_index);
+std::unique_ptr<Driver> make_sim_driver(const SimConfig& config, std::uint64_t run_index, DriverClock& clock) {
+  return std::make_unique<SimDriver>(config, run_index, clock);
 }
 
 }  // namespace covtrack::sim
