@@ -49,7 +49,8 @@ EdgeShifts CornerNoiseModel::edge_shift_px(const CornerInputs& in) const {
 }
 
 double CornerNoiseModel::sigma_px(const CornerInputs& in) const {
-  return std::sqrt(floor_px * floor_px + sample_floor_px * sample_floor_px * sample_factor(in.edge_length_px) +
+  return std::sqrt(floor_px * floor_px +
+                   sample_floor_px * sample_floor_px * sample_factor(in.edge_length_px) +
                    gain_px * gain_px * noise_term(in.image_noise, in.contrast, in.edge_length_px) +
                    aligned_px * aligned_px * in.axis_alignment);
 }

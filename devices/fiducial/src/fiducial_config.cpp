@@ -68,7 +68,8 @@ std::vector<KeySpec> corner_model_keys() {
   return {
         {"corner_gain_px", ValueType::Float, "px", "1.1247", "corner noise model: noise/contrast gain "
          "(devices/fiducial/README.md)", 0, 100},
-        {"corner_floor_px", ValueType::Float, "px", "0.0286", "corner noise model: per-camera floor", 0, 100},
+        {"corner_floor_px", ValueType::Float, "px", "0.0286", "corner noise model: per-camera floor "
+         "for any tag size", 0, 100},
         {"corner_sample_floor_px", ValueType::Float, "px", "0.0357", "corner noise model: per-camera "
          "floor of each edge sample, averaged by the edge fit (shrinks as 128 / edge length above "
          "128 px)", 0, 100},
