@@ -59,18 +59,15 @@ Result<std::unique_ptr<ClaimListener>> ClaimListener::open(const std::string& ur
   if (fd < 0) return fail(fmt::format("claims: socket: {}", std::strerror(errno)));
   std::unique_ptr<ClaimListener> listener(new ClaimListener(fd));
   const int one = 1;
-  sockaddr_in any{};
-  any.sin_family = AF_INET;
-  any.sin_port = group->sin_port;
-  any.sin_addr.s_addr = htonl(INADDR_ANY);
   ip_mreq membership{};
   membership.imr_multiaddr = group->sin_addr;
   membership.imr_interface.s_addr = htonl(INADDR_ANY);
   const sock_fprog program{static_cast<unsigned short>(std::size(kFilter)), const_cast<sock_filter*>(kFilter)};
-  // The filter before the bind: no datagram gets in unfiltered.
+  // The filter before the bind: no datagram gets in unfiltered. Bound to the group's
+  // address, not to any: another group on the same port (another lab's daemons) stays out.
   if (::setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &program, sizeof program) != 0 ||
       ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) != 0 ||
-      ::bind(fd, reinterpret_cast<const sockaddr*>(&any), sizeof any) != 0 ||
+      ::bind(fd, reinterpret_cast<const sockaddr*>(&*group), sizeof *group) != 0 ||
       ::setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &membership, sizeof membership) != 0)
     return fail(fmt::format("claims: cannot listen on {}: {}", url, std::strerror(errno)));
   return listener;

@@ -9,7 +9,7 @@
 #include <random>
 
 #include "covtrack/devices/motion_gate.hpp"
-#include "covtrack/devices/sim/se3_gaussian.hpp"
+#include "covtrack/protocol/se3_gaussian.hpp"
 
 using namespace covtrack;
 
@@ -48,7 +48,7 @@ Tally run_stream(MotionGate& gate, int n, bool moving, std::uint64_t seed, Corru
                  int* corrupt_published = nullptr) {
   std::mt19937_64 rng(seed);
   const Mat6 cov = tracker_covariance();
-  const sim::Se3Gaussian noise(cov);
+  const Se3Gaussian noise(cov);
   Tally t;
   for (int i = 0; i < n; ++i) {
     const double time_s = i / kRate_hz;
@@ -184,7 +184,7 @@ TEST(MotionGate, AStillSensorThatStartsMovingIsNotDropped) {
   MotionGate gate(MotionLimits{}, 1 / kRate_hz);
   std::mt19937_64 rng(5);
   const Mat6 cov = tracker_covariance();
-  const sim::Se3Gaussian noise(cov);
+  const Se3Gaussian noise(cov);
   int rejected = 0, outside = 0, published = 0;
   for (int i = 0; i < 480; ++i) {
     const double t = i / kRate_hz, a = 20;

@@ -212,6 +212,24 @@ TEST(Ownership, TwoDaemonsStartedAtOnceLeaveExactlyOnePublisher) {
   EXPECT_FALSE(winner->process->wait(0)) << winner->output();
 }
 
+TEST(Ownership, DaemonsOnAnotherGroupOfTheSamePortDoNotCountAsHolders) {
+  // Two labs on one network, each its own multicast group, the same port: the second
+  // daemon must not hear the first's claims and heartbeats (a socket bound to any
+  // address on the port would).
+  const std::string url = url_for(7734);
+  const std::string other_url = "udpm://239.255.76.68:7734?ttl=0";
+  HeartbeatLog heartbeats(other_url);
+  ASSERT_TRUE(heartbeats.good());
+  const std::string config = write_config("groups", config_text());
+  Daemon first("groups_first", config, url);
+  Daemon second("groups_second", config, other_url);
+  // Past the claim wait, the second publishes the device as its own.
+  ASSERT_TRUE(heartbeats.more_from(second.pid(), 5)) << second.output();
+  EXPECT_FALSE(second.process->wait(0)) << second.output();
+  EXPECT_FALSE(first.process->wait(0)) << first.output();
+  EXPECT_EQ(second.output().find("not started"), std::string::npos) << second.output();
+}
+
 TEST(Ownership, WithoutAClaimWaitTheLaterClaimGivesTheDeviceUpWhenTheHeartbeatsMeet) {
   const std::string url = url_for(7733);
   HeartbeatLog heartbeats(url);

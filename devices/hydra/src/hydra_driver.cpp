@@ -35,8 +35,9 @@ class HydraDriver final : public Driver {
     if (hid_init() != 0) return fail("Razer Hydra: hidapi cannot start");
     const std::string path = config_.hid_path.empty() ? find_hydra_path() : config_.hid_path;
     if (path.empty())
-      return fail("Razer Hydra: device not found (USB 1532:0300, interface 0): is it plugged in, "
-                  "and may this user open /dev/hidraw* (udev rule)?");
+      return fail(fmt::format("Razer Hydra: device not found (USB {:04x}:{:04x}, interface {}): is it plugged "
+                              "in, and may this user open /dev/hidraw* (udev rule)?",
+                              kVendorId, kProductId, kDataInterface));
     // hidapi opens whatever it is given, in blocking mode; only a hidraw node (a character
     // device) can be a Hydra, and a FIFO or a file there is named here instead.
     if (auto kind = require_character_device(path, "Razer Hydra: hid_path"); !kind) return kind;

@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/sim/se3_gaussian.hpp"
+#include "covtrack/protocol/se3_gaussian.hpp"
 #include "motion.hpp"
 
 namespace covtrack::sim {

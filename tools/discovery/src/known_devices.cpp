@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "covtrack/devices/hydra/hydra_report.hpp"
+
 namespace covtrack::discovery {
 
 const std::vector<KnownDevice>& known_devices() {
@@ -22,7 +24,7 @@ const std::vector<KnownDevice>& known_devices() {
        "load its firmware first (fxload, Polhemus' Linux tools); it then re-appears as 0f44:ff20"},
       {0x0f44, 0, "Polhemus USB device", "liberty",
        "LIBERTY/PATRIOT speak type liberty, FASTRAK type fastrak; use its serial port"},
-      {0x1532, 0x0300, "Razer Hydra", "hydra", "two controllers over HID feature reports"},
+      {hydra::kVendorId, hydra::kProductId, "Razer Hydra", "hydra", "two controllers over HID feature reports"},
   };
   return table;
 }

@@ -6,7 +6,7 @@
 
 #include "covtrack/devices/serial/pseudo_terminal.hpp"
 #include "covtrack/devices/serial6dof/covariance_model.hpp"
-#include "covtrack/devices/sim/se3_gaussian.hpp"
+#include "covtrack/protocol/se3_gaussian.hpp"
 #include "emulated_unit.hpp"
 #include "line_noise.hpp"
 #include "sway.hpp"
@@ -126,7 +126,7 @@ class Emulator::Impl {
       truth.device_time_s = static_cast<double>(time_us % 1000000000) * 1e-6;
       // The noise the driver will claim for this record (same model, same inflation).
       const auto u = record_uncertainty(truth, spec_, std::nullopt, config_.trouble_inflation);
-      const Pose T_est = T_true * se3_exp(-sim::Se3Gaussian(u.covariance).draw(rng_));
+      const Pose T_est = T_true * se3_exp(-Se3Gaussian(u.covariance).draw(rng_));
       TrackerRecord r = truth;
       r.position_m = T_est.translation();
       r.orientation = Eigen::Quaterniond(T_est.linear());

@@ -1,12 +1,12 @@
 #pragma once
-// Draws right perturbations xi ~ N(0, cov) on SE(3): the simulated tracker reports
-// T_est = T_true * Exp(-xi), so that T_true = T_est * Exp(xi) has exactly the reported
-// covariance (protocol/README.md).
+// Draws right perturbations xi ~ N(0, cov) on SE(3): a simulated tracker or emulated unit
+// reports T_est = T_true * Exp(-xi), so that T_true = T_est * Exp(xi) has exactly the
+// reported covariance (protocol/README.md).
 #include <random>
 
 #include "covtrack/protocol/se3.hpp"
 
-namespace covtrack::sim {
+namespace covtrack {
 
 class Se3Gaussian {
  public:
@@ -19,4 +19,4 @@ class Se3Gaussian {
   Mat6 sqrt_cov_;
 };
 
-}  // namespace covtrack::sim
+}  // namespace covtrack

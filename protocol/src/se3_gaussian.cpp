@@ -1,8 +1,8 @@
-#include "covtrack/devices/sim/se3_gaussian.hpp"
+#include "covtrack/protocol/se3_gaussian.hpp"
 
 #include <Eigen/Eigenvalues>
 
-namespace covtrack::sim {
+namespace covtrack {
 
 Se3Gaussian::Se3Gaussian(const Mat6& cov) {
   const Eigen::SelfAdjointEigenSolver<Mat6> eig(0.5 * (cov + cov.transpose()));
@@ -16,4 +16,4 @@ Vec6 Se3Gaussian::draw(std::mt19937_64& rng) const {
   return sqrt_cov_ * z;
 }
 
-}  // namespace covtrack::sim
+}  // namespace covtrack
