@@ -67,7 +67,8 @@ bool inside(const CameraModel& cam, const std::array<cv::Point2d, 4>& c, double 
 CornerNoiseModel camera_model(double bias, double independent, double scale, double edge) {
   CornerNoiseModel m;
   m.scale_bias_per_blur = bias;
-  m.gain_px *= independent, m.floor_px *= independent, m.aligned_px *= independent;
+  m.gain_px *= independent, m.floor_px *= independent, m.sample_floor_px *= independent;
+  m.aligned_px *= independent;
   m.scale_sigma_px *= scale, m.scale_per_blur *= scale;
   m.edge_sigma_px *= edge, m.edge_per_blur *= edge;
   return m;

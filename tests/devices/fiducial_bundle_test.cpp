@@ -267,9 +267,9 @@ TEST(FiducialBundle, NeesOfTheBundlePoseOnHeldOutRenders) {
   EXPECT_LT(sum[1] / n[1], tent_hi);
   // The tents (a non-planar object) within both bounds.
   EXPECT_GT(sum[1] / n[1], tent_lo);
-  // The boards are under-confident, about 2x (measured 2.78): the corner model puts half
+  // The boards are under-confident, about 2x (measured 2.67): the corner model puts half
   // of its independent variance into each edge's placement, which a board's pose rests
-  // on, where these renders show 0.37x of it (ResidualsByTermOnHeldOutRenders;
+  // on, where these renders show 0.36x of it (ResidualsByTermOnHeldOutRenders;
   // devices/fiducial/README.md, "Still weak"). This bounds it at 2.5x.
   EXPECT_GT(sum[0] / n[0], 6 / 2.5);
   // Consistent tags are rarely called inconsistent at the default limit.

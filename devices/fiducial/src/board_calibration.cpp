@@ -215,7 +215,7 @@ std::vector<Residual> residuals_of(const CameraModel& camera, const TagBundle& b
 CornerNoiseModel with_factors(CornerNoiseModel m, const Params& p) {
   const double kI = std::exp(p[1]), kS = std::exp(p[2]), kE = std::exp(p[3]);
   m.scale_bias_per_blur = p[0];
-  m.gain_px *= kI, m.floor_px *= kI, m.aligned_px *= kI;
+  m.gain_px *= kI, m.floor_px *= kI, m.sample_floor_px *= kI, m.aligned_px *= kI;
   m.scale_sigma_px *= kS, m.scale_per_blur *= kS;
   m.edge_sigma_px *= kE, m.edge_per_blur *= kE;
   return m;

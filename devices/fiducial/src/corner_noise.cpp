@@ -10,9 +10,14 @@
 
 namespace covtrack::fiducial {
 
+double CornerNoiseModel::sample_factor(double edge_length_px) {
+  // AprilTag 3's refine_edges samples each edge at max(16, L / 8) points.
+  return 16.0 / std::max(16.0, edge_length_px / 8.0);
+}
+
 double CornerNoiseModel::noise_term(double image_noise, double contrast, double edge_length_px) {
   const double ratio = image_noise / std::max(contrast, 1.0);
-  return ratio * ratio * 16.0 / std::max(16.0, edge_length_px / 8.0);
+  return ratio * ratio * sample_factor(edge_length_px);
 }
 
 std::array<double, 4> CornerNoiseModel::edge_reach(const CornerInputs& in) const {
@@ -45,6 +50,7 @@ EdgeShifts CornerNoiseModel::edge_shift_px(const CornerInputs& in) const {
 
 double CornerNoiseModel::sigma_px(const CornerInputs& in) const {
   return std::sqrt(floor_px * floor_px +
+                   sample_floor_px * sample_floor_px * sample_factor(in.edge_length_px) +
                    gain_px * gain_px * noise_term(in.image_noise, in.contrast, in.edge_length_px) +
                    aligned_px * aligned_px * in.axis_alignment);
 }

@@ -66,23 +66,27 @@ const TableSpec& fiducial_device_spec() {
 
 std::vector<KeySpec> corner_model_keys() {
   return {
-        {"corner_gain_px", ValueType::Float, "px", "1.1673", "corner noise model: noise/contrast gain "
+        {"corner_gain_px", ValueType::Float, "px", "1.1247", "corner noise model: noise/contrast gain "
          "(devices/fiducial/README.md)", 0, 100},
-        {"corner_floor_px", ValueType::Float, "px", "0.0436", "corner noise model: per-camera floor", 0, 100},
-        {"corner_aligned_px", ValueType::Float, "px", "0.0522", "corner noise model: edges along "
+        {"corner_floor_px", ValueType::Float, "px", "0.0286", "corner noise model: per-camera floor "
+         "for any tag size", 0, 100},
+        {"corner_sample_floor_px", ValueType::Float, "px", "0.0357", "corner noise model: per-camera "
+         "floor of each edge sample, averaged by the edge fit (shrinks as 128 / edge length above "
+         "128 px)", 0, 100},
+        {"corner_aligned_px", ValueType::Float, "px", "0.0513", "corner noise model: edges along "
          "pixel axes", 0, 100},
         {"corner_shift_px", ValueType::Float, "px", "1.6552", "corner noise model: outward shift of "
          "an edge lined inside by white cells, at zero border width (corrected)", 0, 100},
         {"corner_shift_falloff", ValueType::Float, "", "0.20", "corner noise model: that shift "
          "fades as exp(-falloff (border / blur)^2)", 0, 100},
-        {"corner_shift_sigma_px", ValueType::Float, "px", "1.8573", "corner noise model: what the "
+        {"corner_shift_sigma_px", ValueType::Float, "px", "1.7794", "corner noise model: what the "
          "shift correction misses, at full reach", 0, 100},
         {"corner_scale_bias_per_blur", ValueType::Float, "", "-0.2578", "corner noise model: every "
          "edge's mean outward error per px of edge blur for a dark square (a light one: the "
          "opposite), from the camera's tone curve (removed)", -10, 10},
-        {"corner_scale_sigma_px", ValueType::Float, "px", "0.0642", "corner noise model: spread of "
+        {"corner_scale_sigma_px", ValueType::Float, "px", "0.0643", "corner noise model: spread of "
          "the four edges' common outward error (the tag's apparent size), floor", 0, 100},
-        {"corner_scale_per_blur", ValueType::Float, "", "0.1207", "corner noise model: that spread's "
+        {"corner_scale_per_blur", ValueType::Float, "", "0.1208", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},
         {"corner_edge_sigma_px", ValueType::Float, "px", "0", "corner noise model: spread of each "
          "edge's own outward error, floor", 0, 100},
@@ -98,7 +102,8 @@ std::vector<KeySpec> corner_model_keys() {
 const std::vector<CornerModelField>& corner_model_fields() {
   using M = CornerNoiseModel;
   static const std::vector<CornerModelField> fields{
-      {"corner_gain_px", &M::gain_px}, {"corner_floor_px", &M::floor_px}, {"corner_aligned_px", &M::aligned_px},
+      {"corner_gain_px", &M::gain_px}, {"corner_floor_px", &M::floor_px},
+      {"corner_sample_floor_px", &M::sample_floor_px}, {"corner_aligned_px", &M::aligned_px},
       {"corner_shift_px", &M::shift_px}, {"corner_shift_falloff", &M::shift_falloff},
       {"corner_shift_sigma_px", &M::shift_sigma_px}, {"corner_scale_bias_per_blur", &M::scale_bias_per_blur},
       {"corner_scale_sigma_px", &M::scale_sigma_px}, {"corner_scale_per_blur", &M::scale_per_blur},
@@ -164,8 +169,8 @@ std::string relative_to_config(const std::string& path, const std::string& confi
 // The corner_* keys of `r`, each defaulting to `m`'s value.
 CornerNoiseModel read_corner_model_keys(TableReader& r, CornerNoiseModel m) {
   for (const CornerModelField& f : corner_model_fields()) m.*f.value = r.number(f.key, m.*f.value);
-  if (m.floor_px <= 0 && m.gain_px <= 0)
-    r.error("corner_floor_px", "the corner noise model needs a floor or a gain above zero");
+  if (m.floor_px <= 0 && m.sample_floor_px <= 0 && m.gain_px <= 0)
+    r.error("corner_floor_px", "the corner noise model needs a floor, a sample floor or a gain above zero");
   return m;
 }
 

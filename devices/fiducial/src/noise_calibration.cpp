@@ -115,12 +115,15 @@ double mean_pose_nees(const CalibrationView& view,
 
 namespace {
 
-using Vec4 = Eigen::Vector4d;
+// The independent variance's terms: floor, image noise, axis alignment, white-cell shift
+// residual, per-sample floor.
+constexpr int kTerms = 5;
+using Terms = Eigen::Matrix<double, kTerms, 1>;
 
-// One corner of one draw, ready for the fit: its four variance terms (sigma^2 = c . terms)
+// One corner of one draw, ready for the fit: its variance terms (sigma^2 = c . terms)
 // and its squared error (radial part removed).
 struct CornerSample {
-  Vec4 terms;
+  Terms terms;
   double sq_px2;
 };
 
@@ -161,7 +164,9 @@ std::vector<std::vector<CornerSample>> corner_samples(const CornerNoiseModel& mo
         const std::size_t a = (k + 3) % 4;  // corner k joins edges k - 1 and k
         const double r = reach[a] * reach[a] + reach[k] * reach[k];
         const cv::Point2d e = de.errors.error_px[k] - mean[k];
-        samples.push_back({Vec4(1, noise, in.axis_alignment, r), e.dot(e) * n / (n - 1)});
+        Terms t;
+        t << 1, noise, in.axis_alignment, r, CornerNoiseModel::sample_factor(in.edge_length_px);
+        samples.push_back({t, e.dot(e) * n / (n - 1)});
       }
     }
   }
@@ -170,21 +175,22 @@ std::vector<std::vector<CornerSample>> corner_samples(const CornerNoiseModel& mo
 
 // A starting point: least squares of each view's mean squared corner error on the mean
 // terms, relative residuals; a negative coefficient is dropped.
-Vec4 initial_terms(const std::vector<std::vector<CornerSample>>& views) {
-  std::vector<Vec4> xs;
+Terms initial_terms(const std::vector<std::vector<CornerSample>>& views) {
+  std::vector<Terms> xs;
   std::vector<double> ys;
   for (const auto& samples : views) {
     if (samples.empty()) continue;
-    Vec4 x = Vec4::Zero();
+    Terms x = Terms::Zero();
     double y = 0;
     for (const CornerSample& s : samples) x += s.terms, y += s.sq_px2 / 2;
     xs.push_back(x / samples.size()), ys.push_back(y / samples.size());
   }
-  std::array<bool, 4> used{true, true, true, true};
-  Vec4 c = Vec4::Zero();
-  for (int round = 0; round < 4; ++round) {
+  std::array<bool, kTerms> used{};
+  used.fill(true);
+  Terms c = Terms::Zero();
+  for (int round = 0; round < kTerms; ++round) {
     std::vector<int> cols;
-    for (int k = 0; k < 4; ++k)
+    for (int k = 0; k < kTerms; ++k)
       if (used[static_cast<std::size_t>(k)]) cols.push_back(k);
     if (cols.empty() || xs.empty()) break;
     Eigen::MatrixXd A(static_cast<Eigen::Index>(xs.size()), static_cast<Eigen::Index>(cols.size()));
@@ -208,7 +214,7 @@ Vec4 initial_terms(const std::vector<std::vector<CornerSample>>& views) {
 // Sum over views of log(view's corner NEES per coordinate)^2: a view 2x over-confident
 // costs what a view 2x under-confident costs, and a few badly fitting views cannot pull
 // every other one off as a pooled mean would.
-double log_ratio_cost(const std::vector<std::vector<CornerSample>>& views, const Vec4& c) {
+double log_ratio_cost(const std::vector<std::vector<CornerSample>>& views, const Terms& c) {
   double cost = 0;
   for (const auto& samples : views) {
     double sum = 0;
@@ -343,10 +349,10 @@ CornerNoiseModel fit_corner_noise(const std::vector<CalibrationView>& views,
   fit_edge_shift(m, draws);
   const ErrorsByView errors = errors_by_view(m, draws);
   const auto samples = corner_samples(m, errors);
-  Vec4 c = initial_terms(samples);
-  log_search(c, [&](const Vec4& t) { return log_ratio_cost(samples, t); }, 1e-8);
+  Terms c = initial_terms(samples);
+  log_search(c, [&](const Terms& t) { return log_ratio_cost(samples, t); }, 1e-8);
   m.floor_px = std::sqrt(c[0]), m.gain_px = std::sqrt(c[1]), m.aligned_px = std::sqrt(c[2]);
-  m.shift_sigma_px = std::sqrt(c[3]);
+  m.shift_sigma_px = std::sqrt(c[3]), m.sample_floor_px = std::sqrt(c[4]);
   fit_systematic_terms(m, errors);
   // Stage 4 on the pooled NEES: with the systematic terms in the model a view's own mean
   // NEES is expected to scatter (its biases are one draw of them), so only the pool says
@@ -362,7 +368,7 @@ CornerNoiseModel fit_corner_noise(const std::vector<CalibrationView>& views,
     if (n == 0 || sum <= 0) break;
     // NEES scales as 1 / sigma^2.
     const double f = std::sqrt(sum / n / 6.0);
-    m.floor_px *= f, m.gain_px *= f, m.aligned_px *= f, m.shift_sigma_px *= f;
+    m.floor_px *= f, m.sample_floor_px *= f, m.gain_px *= f, m.aligned_px *= f, m.shift_sigma_px *= f;
     m.scale_sigma_px *= f, m.scale_per_blur *= f, m.edge_sigma_px *= f, m.edge_per_blur *= f;
     m.tilt_sigma_px *= f, m.tilt_per_blur *= f;
   }

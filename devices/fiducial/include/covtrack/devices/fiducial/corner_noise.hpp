@@ -2,13 +2,18 @@
 // How well the detector places a tag corner, from what limits it (docs in
 // devices/fiducial/README.md, "Corner noise model"):
 //
-//   sigma_corner^2 = floor_px^2 + gain_px^2 * (noise / contrast)^2 * 16 / max(16, L / 8)
-//                    + aligned_px^2 * A + shift_sigma_px^2 * (reach_a^2 + reach_b^2)
+//   sigma_corner^2 = floor_px^2 + (sample_floor_px^2 + gain_px^2 * (noise / contrast)^2)
+//                    * 16 / max(16, L / 8) + aligned_px^2 * A
+//                    + shift_sigma_px^2 * (reach_a^2 + reach_b^2)
 //
 // noise: the image's noise (grey levels), contrast: the grey-level step across the tag's
 // border, L: the tag's mean edge length (px). AprilTag fits each edge to max(16, L/8)
 // sample points placed by the image gradient; each point's error grows with
-// noise / contrast and the fitted line's end (the corner) averages them.
+// noise / contrast and the fitted line's end (the corner) averages them. Each point also
+// has an error that image noise does not explain and that differs from point to point
+// (where the edge crosses the pixel grid, the interpolation): the line averages it the
+// same way (sample_floor_px), so for tags with edges over 128 px it shrinks as 128 / L.
+// What stays for any size is floor_px.
 // A: how close the edges lie to the pixel axes (mean over edges of
 // exp(-(angle to the nearest axis / 3 deg)^2)). AprilTag samples the edge gradient at
 // whole pixels, so an edge along a pixel row sees the same sub-pixel phase all along and
@@ -69,16 +74,17 @@ struct CornerInputs {
 // population (tone curves gamma 1-2.4, blur 0.4-1.25 px plus defocus, JPEG 75-97 or none;
 // devices/fiducial/README.md); config/schema.md lists the same values.
 struct CornerNoiseModel {
-  double gain_px = 1.1673;
-  double floor_px = 0.0436;
-  double aligned_px = 0.0522;
+  double gain_px = 1.1247;
+  double floor_px = 0.0286;         // independent of the tag's size
+  double sample_floor_px = 0.0357;  // per edge sample: averaged by the edge fit (above)
+  double aligned_px = 0.0513;
   double shift_px = 1.6552;        // outward edge shift with all-white cells inside, zero border
   double shift_falloff = 0.20;     // how fast it fades with border / blur (see above)
-  double shift_sigma_px = 1.8573;  // the shift correction's uncertainty at reach 1
+  double shift_sigma_px = 1.7794;  // the shift correction's uncertainty at reach 1
   double scale_bias_per_blur = -0.2578;  // every edge's mean outward error per px of blur,
                                          // for a dark square (a light one: the opposite)
-  double scale_sigma_px = 0.0642;  // the four edges' common outward error: its floor
-  double scale_per_blur = 0.1207;  //   and its growth per px of edge blur
+  double scale_sigma_px = 0.0643;  // the four edges' common outward error: its floor
+  double scale_per_blur = 0.1208;  //   and its growth per px of edge blur
   double edge_sigma_px = 0.0;      // each edge's own outward error: its floor
   double edge_per_blur = 0.0282;   //   and its growth per px of edge blur
   double tilt_sigma_px = 0.0099;   // each edge's own turn (its ends' opposite outward
@@ -97,7 +103,9 @@ struct CornerNoiseModel {
   double tilt_sigma(const CornerInputs& in) const;
   // Everything estimate_tag_pose needs.
   CornerNoise noise(const CornerInputs& in) const;
-  // The noise-driven factor the gain multiplies: (noise / contrast)^2 * 16 / max(16, L/8).
+  // How the edge fit averages its samples' errors: 16 / max(16, L / 8).
+  static double sample_factor(double edge_length_px);
+  // The noise-driven factor the gain multiplies: (noise / contrast)^2 * sample_factor(L).
   static double noise_term(double image_noise, double contrast, double edge_length_px);
 };
 

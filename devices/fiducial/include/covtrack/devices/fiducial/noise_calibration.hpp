@@ -52,10 +52,10 @@ CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& draw);
 // Four stages (devices/fiducial/README.md, "Calibration procedure").
 // (1) The predicted edge shifts: shift_px, shift_falloff and scale_bias_per_blur by least
 //     squares of each edge's outward error on white * reach and on polarity * blur.
-// (2) The independent corner coefficients (floor, gain, aligned, shift_sigma) on the
-//     draw-to-draw spread of each corner about its view's mean, minimising the sum over
-//     views of log(view's corner NEES per coordinate)^2, so that over- and
-//     under-confident views weigh alike.
+// (2) The independent corner coefficients (floor, sample floor, gain, aligned,
+//     shift_sigma) on the draw-to-draw spread of each corner about its view's mean,
+//     minimising the sum over views of log(view's corner NEES per coordinate)^2, so that
+//     over- and under-confident views weigh alike.
 // (3) The systematic terms from the views' mean edge errors: their common part (scale)
 //     and the rest (edge), and the ends' opposite parts (tilt), each as floor^2 + (per_blur * blur)^2 by least squares over
 //     views, less the means' own sampling variance.

@@ -1,0 +1,187 @@
+// Run by hand (about 5 min): build/tests/devices/fiducial_corner_terms_probe
+// How well each term of the corner noise model matches the corner errors, by the tag's
+// size in pixels and by distance band, on the held-out check's calibration set and (for
+// reporting only: nothing is fitted on it) its validation set. The model is the one the
+// calibration fits (fit_corner_noise), as in fiducial_heldout_nees_test. Per term, the
+// observed variance over the modelled one (1 when right): `indep` each corner's
+// draw-to-draw spread, `scale` a view's mean common outward error of the four edges,
+// `edge` each edge's own, `turn` each edge's mean turn (devices/fiducial/README.md). Then
+// the pose NEES per principal direction of the pose covariance (tightest first; 1 each
+// when right), and the pose NEES with one term's variance halved (which term the pose's
+// covariance rests on).
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+
+#include "fiducial_heldout_sets.hpp"
+
+using namespace covtrack;
+using namespace covtrack::fiducial;
+using test::TagRun;
+
+namespace {
+
+using Draws = std::vector<std::vector<ViewDraw>>;
+
+Draws draws_of(const std::vector<TagRun>& runs, std::uint64_t first_seed) {
+  Draws out;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    auto d = draw_view(test::detector_options(runs[i]), runs[i].view, test::kDraws, first_seed + i);
+    out.push_back(d ? *d : std::vector<ViewDraw>{});
+  }
+  return out;
+}
+
+bool near_band(const TagRun& r) { return r.view.tag.T_camera_tag.translation().z() < 1.0; }
+
+struct Ratio {
+  double observed = 0, modelled = 0;
+  double value() const { return modelled > 0 ? observed / modelled : 0; }
+};
+struct Group {
+  Ratio indep, scale, edge, turn;
+  double nees_sum = 0;
+  int nees_n = 0, views = 0;
+};
+
+// One view's contributions (the same split as the calibration's stages 2 and 3).
+void add_view(Group& g, const TagRun& run, const std::vector<ViewDraw>& draws, const CornerNoiseModel& m) {
+  std::vector<CornerErrors> errors;
+  std::vector<const ViewDraw*> used;
+  for (const ViewDraw& d : draws)
+    if (d.detection && std::isfinite(d.inputs.blur_px)) errors.push_back(corner_errors(m, d)), used.push_back(&d);
+  const double n = static_cast<double>(errors.size());
+  if (n < 3) return;
+  std::array<cv::Point2d, 4> mean{};
+  for (const auto& e : errors)
+    for (std::size_t k = 0; k < 4; ++k) mean[k] += e.error_px[k] / n;
+  for (std::size_t j = 0; j < errors.size(); ++j) {
+    const CornerNoise noise = m.noise(used[j]->inputs);
+    for (std::size_t k = 0; k < 4; ++k) {
+      const cv::Point2d e = errors[j].error_px[k] - mean[k];
+      g.indep.observed += e.dot(e) * n / (n - 1) / 2;
+      g.indep.modelled += noise.sigma_px * noise.sigma_px + noise.extra_px[k] * noise.extra_px[k];
+    }
+  }
+  std::array<double, 4> out{}, out_var{}, turn{}, turn_var{};
+  for (const auto& e : errors)
+    for (std::size_t k = 0; k < 4; ++k) out[k] += e.edge_out_px[k] / n, turn[k] += e.edge_turn_px[k] / n;
+  for (const auto& e : errors)
+    for (std::size_t k = 0; k < 4; ++k) {
+      out_var[k] += std::pow(e.edge_out_px[k] - out[k], 2) / (n - 1);
+      turn_var[k] += std::pow(e.edge_turn_px[k] - turn[k], 2) / (n - 1);
+    }
+  const double common = (out[0] + out[1] + out[2] + out[3]) / 4;
+  const double mean_var = (out_var[0] + out_var[1] + out_var[2] + out_var[3]) / 4;
+  double rest = 0, turn_sq = 0, turn_mean_var = 0;
+  for (std::size_t k = 0; k < 4; ++k)
+    rest += std::pow(out[k] - common, 2) / 4, turn_sq += turn[k] * turn[k] / 4, turn_mean_var += turn_var[k] / 4;
+  const CornerNoise noise = m.noise(used[0]->inputs);
+  g.scale.observed += common * common - mean_var / (4 * n);
+  g.scale.modelled += noise.scale_sigma_px * noise.scale_sigma_px;
+  g.edge.observed += (rest - 0.75 * mean_var / n) * 4 / 3;
+  g.edge.modelled += noise.edge_sigma_px * noise.edge_sigma_px;
+  g.turn.observed += turn_sq - turn_mean_var / n;
+  g.turn.modelled += noise.tilt_sigma_px * noise.tilt_sigma_px;
+  int posed = 0;
+  const double nees = mean_pose_nees(run.view, draws, m, &posed);
+  g.nees_sum += nees * posed, g.nees_n += posed, ++g.views;
+}
+
+void print_terms(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
+  constexpr double kEdges[] = {0, 50, 80, 120, 180, 1e9};
+  std::map<std::string, Group> groups;
+  for (std::size_t v = 0; v < runs.size(); ++v) {
+    double length = 0;
+    int n = 0;
+    for (const ViewDraw& d : draws[v])
+      if (d.detection) length += d.inputs.edge_length_px, ++n;
+    if (!n) continue;
+    length /= n;
+    std::size_t b = 0;
+    while (length >= kEdges[b + 1]) ++b;
+    char label[32];
+    std::snprintf(label, sizeof label, "edge %3.0f-%3.0f px", kEdges[b], std::min(kEdges[b + 1], 999.0));
+    add_view(groups[label], runs[v], draws[v], m);
+    add_view(groups[near_band(runs[v]) ? "band 0.5-1 m" : "band 1-1.5 m"], runs[v], draws[v], m);
+  }
+  std::printf("%s: observed / modelled variance per term\n", set);
+  std::printf("  %-16s %5s %6s %6s %6s %6s %6s\n", "group", "views", "NEES", "indep", "scale", "edge", "turn");
+  for (const auto& [label, g] : groups)
+    std::printf("  %-16s %5d %6.2f %6.2f %6.2f %6.2f %6.2f\n", label.c_str(), g.views,
+                g.nees_n ? g.nees_sum / g.nees_n : 0, g.indep.value(), g.scale.value(), g.edge.value(),
+                g.turn.value());
+}
+
+void print_directions(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
+  std::map<std::string, std::array<double, 7>> sums;  // six directions and the count
+  for (std::size_t v = 0; v < runs.size(); ++v)
+    for (const ViewDraw& d : draws[v]) {
+      if (!d.detection) continue;
+      auto pose = estimate_tag_pose(runs[v].view.camera, d.detection->corners_px, runs[v].view.tag.size_m,
+                                    corner_noise(m, d));
+      if (!pose) continue;
+      const Vec6 e = boxminus(d.T_camera_tag_true, pose->best.T_camera_tag);
+      const Eigen::SelfAdjointEigenSolver<Mat6> eig(pose->covariance);
+      auto& s = sums[near_band(runs[v]) ? "band 0.5-1 m" : "band 1-1.5 m"];
+      for (int i = 0; i < 6; ++i) s[i] += std::pow(eig.eigenvectors().col(i).dot(e), 2) / eig.eigenvalues()[i];
+      s[6] += 1;
+    }
+  std::printf("%s: pose NEES per principal direction, tightest first\n", set);
+  for (const auto& [label, s] : sums) {
+    std::printf("  %-16s", label.c_str());
+    for (int i = 0; i < 6; ++i) std::printf(" %5.2f", s[i] / s[6]);
+    std::printf("\n");
+  }
+}
+
+void print_halved(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
+  const double f = std::sqrt(0.5);
+  std::vector<std::pair<const char*, CornerNoiseModel>> models{{"none", m}};
+  const auto halved = [&](const char* name, std::initializer_list<double CornerNoiseModel::*> fields) {
+    CornerNoiseModel x = m;
+    for (auto field : fields) x.*field *= f;
+    models.emplace_back(name, x);
+  };
+  halved("floor", {&CornerNoiseModel::floor_px});
+  halved("sample floor", {&CornerNoiseModel::sample_floor_px});
+  halved("gain", {&CornerNoiseModel::gain_px});
+  halved("aligned", {&CornerNoiseModel::aligned_px});
+  halved("shift sigma", {&CornerNoiseModel::shift_sigma_px});
+  halved("scale", {&CornerNoiseModel::scale_sigma_px, &CornerNoiseModel::scale_per_blur});
+  halved("edge", {&CornerNoiseModel::edge_sigma_px, &CornerNoiseModel::edge_per_blur});
+  halved("turn", {&CornerNoiseModel::tilt_sigma_px, &CornerNoiseModel::tilt_per_blur});
+  std::printf("%s: pose NEES (all, 0.5-1 m, 1-1.5 m) with one term's variance halved\n", set);
+  for (const auto& [name, x] : models) {
+    std::array<double, 3> sum{};
+    std::array<int, 3> count{};
+    for (std::size_t v = 0; v < runs.size(); ++v) {
+      int posed = 0;
+      const double nees = mean_pose_nees(runs[v].view, draws[v], x, &posed);
+      for (std::size_t g : {std::size_t{0}, std::size_t{near_band(runs[v]) ? 1u : 2u}})
+        sum[g] += nees * posed, count[g] += posed;
+    }
+    std::printf("  %-14s %6.2f %6.2f %6.2f\n", name, sum[0] / count[0], sum[1] / count[1], sum[2] / count[2]);
+  }
+}
+
+}  // namespace
+
+int main() {
+  const auto calibration = test::calibration_set();
+  const auto validation = test::validation_set();
+  const Draws calibration_draws = draws_of(calibration, 1);  // the test's seeds
+  std::vector<CalibrationView> views;
+  for (const auto& r : calibration) views.push_back(r.view);
+  const CornerNoiseModel model = fit_corner_noise(views, calibration_draws);
+  const Draws validation_draws = draws_of(validation, 5000);
+  print_terms("calibration", calibration, calibration_draws, model);
+  print_terms("validation", validation, validation_draws, model);
+  print_directions("calibration", calibration, calibration_draws, model);
+  print_directions("validation", validation, validation_draws, model);
+  print_halved("calibration", calibration, calibration_draws, model);
+  print_halved("validation", validation, validation_draws, model);
+}
