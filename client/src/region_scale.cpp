@@ -6,6 +6,7 @@
 #include <numbers>
 #include <vector>
 
+#include "covtrack/client/assessment.hpp"
 #include "covtrack/client/regions.hpp"
 #include "vector_clones.hpp"
 
@@ -125,7 +126,7 @@ double whole_object_scale2(const Camera& camera, const UncertainPose& pose,
   // s is at most about its expected count of upcrossings, L / (2 pi) exp(-s^2 / 2) (Rice's
   // formula; exact for one point, whose curve is a whole great circle, L = 2 pi). Vertices
   // inside the mean hull are not on the curve: to leave the region they must move farther.
-  const double per_vertex = -2 * std::log1p(-confidence);
+  const double per_vertex = std::pow(confidence_scale(confidence), 2);  // chi2_2(p)
   const std::size_t k = mean_hull.size();
   if (k < 2) return per_vertex;  // one point: the region is its ellipse
   double C[36];

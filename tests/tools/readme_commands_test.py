@@ -19,7 +19,6 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 
 # A refused flag, config or file ends a command within a second even on a loaded machine;
 # the README has some 20 services and benchmarks, each waited for this long.
