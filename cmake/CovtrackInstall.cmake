@@ -18,7 +18,7 @@ install(TARGETS covtrack_protocol covtrack_camera covtrack_client covtrack_lcmlo
         EXPORT covtrackTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(DIRECTORY protocol/include/ client/include/ tools/lcmlog/include/
+install(DIRECTORY protocol/include/ protocol/camera/include/ client/include/ tools/lcmlog/include/
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT dev)
 # lcm-gen's headers (covtrack/pose_cov_t.hpp, ...), which the public headers include.
 install(DIRECTORY ${PROJECT_BINARY_DIR}/protocol/lcmgen/covtrack

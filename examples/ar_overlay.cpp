@@ -15,6 +15,7 @@
 #include <covtrack/client/transform_graph.hpp>
 #include <covtrack/osg/ar_scene.hpp>
 #include <covtrack/osg/ar_viewer.hpp>
+#include <covtrack/protocol/camera.hpp>
 
 using namespace covtrack;
 
@@ -43,7 +44,7 @@ int main(int argc, char** argv) {
   world_crate.rotate(Eigen::AngleAxisd(0.6, Vec3(1, 1, 0).normalized()));
   (void)graph.add_static_edge("world", "crate", world_crate, Mat6::Identity() * 1e-8);
 
-  const client::Camera camera{.fx = 525, .fy = 525, .cx = 319.5, .cy = 239.5, .width_px = 640, .height_px = 480};
+  const Camera camera{.fx = 525, .fy = 525, .cx = 319.5, .cy = 239.5, .width_px = 640, .height_px = 480};
   const Vec3 half(0.06, 0.04, 0.03);  // a 12 x 8 x 6 cm crate
   client::ArObject crate{.name = "crate", .frame = "crate"};
   for (double x : {-1, 1})

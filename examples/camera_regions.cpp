@@ -12,6 +12,7 @@
 #include <covtrack/client/regions.hpp>
 #include <covtrack/client/subscriber.hpp>
 #include <covtrack/client/transform_graph.hpp>
+#include <covtrack/protocol/camera.hpp>
 #include <covtrack/protocol/clock.hpp>
 
 using namespace covtrack;
@@ -35,7 +36,7 @@ int main(int argc, char** argv) {
   world_vase.translate(Vec3(0, 0, 1.5));
   (void)graph.add_static_edge("world", "vase", world_vase, covariance_of(0.003, 0.003));
 
-  client::Camera camera{.fx = 525, .fy = 525, .cx = 319.5, .cy = 239.5, .width_px = 640, .height_px = 480};
+  Camera camera{.fx = 525, .fy = 525, .cx = 319.5, .cy = 239.5, .width_px = 640, .height_px = 480};
   std::vector<Vec3> vase;  // the corners of its 8 x 8 x 12 cm box
   for (double x : {-0.04, 0.04})
     for (double y : {-0.04, 0.04})

@@ -52,13 +52,13 @@ int main() {
   std::printf("%-10s %-6s %5s %12s %10s %14s %9s %10s\n", "frame", "scene", "tags", "detect ms", "pose ms",
               "covariance ms", "cov/det", "bundle ms");
   for (const auto& [width, height, decimate] : {std::tuple{640, 480, 1.0}, std::tuple{1920, 1080, 2.0}}) {
-    CameraModel cam = test::camera(width, height, 70);
-    cam.distortion = (cv::Mat_<double>(5, 1) << -0.1, 0.03, 0, 0, 0);
+    Camera cam = test::camera(width, height, 70);
+    cam.k1 = -0.1, cam.k2 = 0.03;
     for (const bool twelve : {false, true}) {
       const auto tags = twelve ? board(0.7) : std::vector<RenderedTag>{{0, 0.16, test::tag_pose(1.0, 20, 5, 10)}};
       std::mt19937_64 rng(1);
       ImageFormation f;
-      f.true_distortion = cam.distortion;
+      f.true_distortion = distortion_vector(cam);
       f.read_noise = 3;
       const cv::Mat frame = form_image(cam, **family, tags, f, rng);
       DetectorOptions o;

@@ -109,8 +109,8 @@ const std::vector<RenderedTag> kTags = {{2, 0.1, test::tag_pose(0.8, 25, 10, 30,
 // dir/frame_NNNN.ext, one per entry of `views` (the tags in that frame), and dir/camera.yml.
 fs::path write_frames(const fs::path& dir, const std::string& ext,
                       const std::vector<std::vector<RenderedTag>>& views) {
-  const CameraModel cam = test::small_camera();
-  EXPECT_TRUE(save_camera_model(cam, dir / "camera.yml").has_value());
+  const Camera cam = test::small_camera();
+  EXPECT_TRUE(save_camera(cam, dir / "camera.yml").has_value());
   auto family = TagFamily::open("tag36h11");
   std::mt19937_64 rng(5);
   for (std::size_t i = 0; i < views.size(); ++i) {

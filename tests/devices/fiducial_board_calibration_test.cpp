@@ -48,14 +48,14 @@ Pose random_board_pose(std::mt19937_64& rng) {
                         0.03 * u(rng));
 }
 
-std::array<cv::Point2d, 4> projected_corners(const CameraModel& cam, const Pose& T_camera_tag, double size_m) {
+std::array<cv::Point2d, 4> projected_corners(const Camera& cam, const Pose& T_camera_tag, double size_m) {
   const auto X = tag_corner_points(size_m);
   std::array<cv::Point2d, 4> c;
-  for (int k = 0; k < 4; ++k) c[k] = cam.project(T_camera_tag * X[k]);
+  for (int k = 0; k < 4; ++k) c[k] = pinhole_pixel(cam, T_camera_tag * X[k]);
   return c;
 }
 
-bool inside(const CameraModel& cam, const std::array<cv::Point2d, 4>& c, double margin_px) {
+bool inside(const Camera& cam, const std::array<cv::Point2d, 4>& c, double margin_px) {
   for (const auto& p : c)
     if (p.x < margin_px || p.y < margin_px || p.x > cam.width_px - 1 - margin_px ||
         p.y > cam.height_px - 1 - margin_px)
@@ -76,7 +76,7 @@ CornerNoiseModel camera_model(double bias, double independent, double scale, dou
 
 // Frames of the board whose corners are drawn from `truth`: each tag's edges moved out by
 // the model's predicted shifts, then the full corner covariance's noise.
-std::vector<BoardFrame> drawn_frames(const CameraModel& cam, const TagBundle& b, const TagFamily& family,
+std::vector<BoardFrame> drawn_frames(const Camera& cam, const TagBundle& b, const TagFamily& family,
                                      const CornerNoiseModel& truth, int count, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
@@ -117,7 +117,7 @@ std::vector<BoardFrame> drawn_frames(const CameraModel& cam, const TagBundle& b,
 // Catches a wrong mean or covariance in the likelihood, a factor applied to the wrong
 // term, or an optimiser that stops short.
 TEST(BoardCalibration, RecoversTheModelItsCornersWereDrawnFrom) {
-  const CameraModel cam = test::camera(800, 600, 58);
+  const Camera cam = test::camera(800, 600, 58);
   auto family = TagFamily::open("tag36h11");
   ASSERT_TRUE(family.has_value());
   const TagBundle b = board(0.045);
@@ -175,7 +175,7 @@ struct RenderedBoard {
   std::vector<Pose> truth;  // T_camera_board per frame
 };
 
-RenderedBoard render_board(const CameraModel& cam, TagDetector& detector, const TagBundle& b,
+RenderedBoard render_board(const Camera& cam, TagDetector& detector, const TagBundle& b,
                            const ImageFormation& formation, int count, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   RenderedBoard out;
@@ -192,7 +192,7 @@ RenderedBoard render_board(const CameraModel& cam, TagDetector& detector, const 
 
 // The camera's scale bias measured against the truth: least squares of every detected
 // tag's corner errors (corrected for all but the bias) on the bias's direction.
-double bias_from_truth(const CameraModel& cam, const TagBundle& b, const RenderedBoard& set) {
+double bias_from_truth(const Camera& cam, const TagBundle& b, const RenderedBoard& set) {
   CornerNoiseModel unbiased;
   unbiased.scale_bias_per_blur = 0;
   double num = 0, den = 0;
@@ -219,7 +219,7 @@ struct SingleTagNees {
 
 // Single tags of the other polarity (tagStandard41h12: light square on a dark ring), drawn
 // by the other rasteriser with another seed, posed under `model`.
-SingleTagNees held_out_nees(const CameraModel& cam, TagDetector& detector, const ImageFormation& formation,
+SingleTagNees held_out_nees(const Camera& cam, TagDetector& detector, const ImageFormation& formation,
                             const CornerNoiseModel& model, int count, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
@@ -262,7 +262,7 @@ std::unique_ptr<TagDetector> detector_for(const char* family) {
 // the tags' apparent size, a sign error by polarity) and a fitted model that holds only on
 // the frames it was fitted to.
 TEST(BoardCalibration, FitsARenderedCameraAsItsTruthShowsAndHoldsOnOtherFrames) {
-  const CameraModel cam = test::camera(800, 600, 58);
+  const Camera cam = test::camera(800, 600, 58);
   auto board_detector = detector_for("tag36h11");
   auto other_polarity = detector_for("tagStandard41h12");
   ASSERT_TRUE(board_detector && other_polarity);

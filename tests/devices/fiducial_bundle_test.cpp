@@ -114,7 +114,7 @@ class Renderer {
     }
   }
 
-  const CameraModel& camera() const { return camera_; }
+  const Camera& camera() const { return camera_; }
   const TagFamily& family(int f) const { return detectors_[static_cast<std::size_t>(f)]->family(); }
 
   // Renders `rendered` (the tags where they really are on the bundle) at T_camera_bundle in
@@ -156,7 +156,7 @@ class Renderer {
   }
 
  private:
-  CameraModel camera_ = test::camera(800, 600, 58);
+  Camera camera_ = test::camera(800, 600, 58);
   CornerNoiseModel model_;
   std::vector<std::unique_ptr<TagDetector>> detectors_;
 };
@@ -191,7 +191,7 @@ std::pair<double, double> mean_bounds(int n) {
 // Catches a wrong Jacobian, a wrong adjoint, or blocks treated as anything but independent.
 TEST(FiducialBundle, CovarianceIsExactForCornersDrawnFromTheModel) {
   constexpr double kChi2_6_999 = 22.458;
-  const CameraModel cam = test::camera(800, 600, 58);
+  const Camera cam = test::camera(800, 600, 58);
   auto family = TagFamily::open("tag36h11");
   ASSERT_TRUE(family.has_value());
   CornerNoise noise;  // systematic terms as large as the defaults give a blurred tag
@@ -207,7 +207,7 @@ TEST(FiducialBundle, CovarianceIsExactForCornersDrawnFromTheModel) {
     for (const BundleTag& t : layout) {
       const auto X = tag_corner_points(t.size_m);
       std::array<cv::Point2d, 4> corners;
-      for (int k = 0; k < 4; ++k) corners[k] = cam.project(T_camera_bundle * t.T_bundle_tag * X[k]);
+      for (int k = 0; k < 4; ++k) corners[k] = pinhole_pixel(cam, T_camera_bundle * t.T_bundle_tag * X[k]);
       const Eigen::Matrix<double, 8, 8> L = corner_covariance(corners, noise).llt().matrixL();
       Eigen::Matrix<double, 8, 1> z;
       for (int i = 0; i < 8; ++i) z(i) = gauss(rng);
@@ -340,7 +340,7 @@ TEST(FiducialBundle, ATagMovedOnTheBoardIsFoundLeftOutAndCovered) {
 // the model's variance of that part (devices/fiducial/README.md, "Still weak"), and the
 // scale's correlation between tags of one frame is measured.
 TEST(FiducialBundle, ResidualsByTermOnHeldOutRenders) {
-  const CameraModel cam = test::camera(800, 600, 58);
+  const Camera cam = test::camera(800, 600, 58);
   struct Parts {
     double observed[3] = {0, 0, 0}, modelled[3] = {0, 0, 0};  // scale, edge placement, turns
     double scale_products = 0;  // over pairs of tags of one frame
@@ -354,7 +354,7 @@ TEST(FiducialBundle, ResidualsByTermOnHeldOutRenders) {
       const auto X = tag_corner_points(o.tag.size_m);
       Eigen::Matrix<double, 8, 1> d;
       for (int k = 0; k < 4; ++k) {
-        const cv::Point2d t = cam.project(f.truth * (o.tag.T_bundle_tag * X[k]));
+        const cv::Point2d t = pinhole_pixel(cam, f.truth * (o.tag.T_bundle_tag * X[k]));
         d(2 * k) = o.pose.corners_px[k].x - t.x, d(2 * k + 1) = o.pose.corners_px[k].y - t.y;
       }
       const Eigen::Matrix<double, 8, 8> to_modes = edge_line_modes(o.pose.corners_px).inverse();

@@ -103,7 +103,7 @@ double chi2_99(int k) {
 }  // namespace
 
 TEST(FiducialCoplanar, TagsOfOneSheetAgreeOnTheirPlane) {
-  const CameraModel cam = test::camera(1280, 720, 70);
+  const Camera cam = test::camera(1280, 720, 70);
   DetectorOptions options;
   options.decimate = 2;
   auto detector = TagDetector::create(options);

@@ -58,8 +58,8 @@ Scene render_sequence(const std::string& name, int frames) {
   Scene s;
   s.dir = fs::path(::testing::TempDir()) / fmt::format("fiducial_{}_{}", name, getpid());
   fs::create_directories(s.dir);
-  const CameraModel cam = test::small_camera();
-  EXPECT_TRUE(save_camera_model(cam, s.dir / "camera.yml").has_value());
+  const Camera cam = test::small_camera();
+  EXPECT_TRUE(save_camera(cam, s.dir / "camera.yml").has_value());
   auto family = TagFamily::open("tag36h11");
   s.tags = {{2, 0.1, test::tag_pose(0.8, 25, 10, 30, -0.1, 0)},
             {9, 0.1, test::tag_pose(1.0, -20, -5, 60, 0.15, 0.05)}};
@@ -110,8 +110,8 @@ BundleScene render_bundle_sequence(const std::string& name, int frames, int with
   BundleScene s{fs::path(::testing::TempDir()) / fmt::format("fiducial_bundle_{}_{}", name, getpid()),
                 test::tag_pose(0.55, 20, 10, 15)};
   fs::create_directories(s.dir);
-  const CameraModel cam = test::camera(640, 480, 60);
-  EXPECT_TRUE(save_camera_model(cam, s.dir / "camera.yml").has_value());
+  const Camera cam = test::camera(640, 480, 60);
+  EXPECT_TRUE(save_camera(cam, s.dir / "camera.yml").has_value());
   auto family = TagFamily::open("tag36h11");
   const RenderedTag tag9{9, 0.08, test::tag_pose(0.7, -15, 0, 0, 0.2, 0.1)};
   std::vector<RenderedTag> with_board{tag9};
@@ -215,7 +215,7 @@ TEST(FiducialDriver, PublishesEveryNthFrameWithItsPosesTime) {
   ASSERT_EQ(frame_times.size(), 6u);  // one time per frame
   const std::vector<std::int64_t> times(frame_times.begin(), frame_times.end());
   ASSERT_EQ(sink.images.size(), 3u);
-  const CameraModel cam = test::small_camera();
+  const Camera cam = test::small_camera();
   for (std::size_t i = 0; i < sink.images.size(); ++i) {
     const ImageSample& image = sink.images[i];
     EXPECT_EQ(image.measurement_time_us, times[2 * i]) << "image " << i;

@@ -60,8 +60,8 @@ TEST(FiducialEdgeBias, ToneCurveShrinksADarkSquareAndGrowsALightOne) {
 TEST(FiducialEdgeBias, LensBendCorrectionPutsCornersWhereTheLensDoes) {
   CalibrationView v;
   v.camera = test::camera(1920, 1080, 80);
-  v.camera.distortion = (cv::Mat_<double>(5, 1) << -0.2, 0.06, 0, 0, 0);
-  v.formation.true_distortion = v.camera.distortion;
+  v.camera.k1 = -0.2, v.camera.k2 = 0.06;
+  v.formation.true_distortion = distortion_vector(v.camera);
   v.formation.read_noise = 0.5;
   // A large tag towards the frame's corner, where the edges bend most.
   v.tag = {5, 0.2, test::tag_pose(0.8, 15, 5, 10, 0.35, 0.18)};

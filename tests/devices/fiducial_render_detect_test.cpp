@@ -23,7 +23,7 @@ struct CornerErrors {
 
 CornerErrors corner_errors(const std::string& family, int id, const Pose& pose, double size_m,
                            double noise, int draws) {
-  const CameraModel cam = test::small_camera();
+  const Camera cam = test::small_camera();
   DetectorOptions opts;
   opts.family = family;
   opts.decimate = 1;
@@ -106,7 +106,7 @@ TEST(FiducialRenderDetect, BorderInnerWhiteReadsTheCodeAlongEachEdge) {
 }
 
 TEST(FiducialRenderDetect, EdgeBlurGrowsWithTheRenderedBlur) {
-  const CameraModel cam = test::small_camera();
+  const Camera cam = test::small_camera();
   auto detector = TagDetector::create(DetectorOptions{.decimate = 1});
   ASSERT_TRUE(detector.has_value());
   const RenderedTag tag{3, 0.15, test::tag_pose(0.8, 20, 10, 5)};
@@ -132,7 +132,7 @@ TEST(FiducialRenderDetect, EdgeBlurGrowsWithTheRenderedBlur) {
 // linear image they must give the same picture up to the warp's sampling, and the same
 // corners to a few hundredths of a pixel.
 TEST(FiducialRenderDetect, BothRasterisersDrawTheSameTag) {
-  const CameraModel cam = test::camera(640, 480, 62);
+  const Camera cam = test::camera(640, 480, 62);
   DetectorOptions opts;
   opts.decimate = 1;
   auto detector = TagDetector::create(opts);

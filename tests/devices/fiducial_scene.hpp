@@ -4,15 +4,15 @@
 #include <cmath>
 #include <random>
 
-#include "covtrack/devices/fiducial/camera_model.hpp"
 #include "covtrack/devices/fiducial/tag_image_formation.hpp"
+#include "covtrack/protocol/camera_opencv.hpp"
 #include "covtrack/protocol/se3.hpp"
 
 namespace covtrack::test {
 
 // 320x240, about 60 degrees across: small frames keep the many detections fast.
-inline fiducial::CameraModel small_camera() {
-  fiducial::CameraModel c;
+inline Camera small_camera() {
+  Camera c;
   c.width_px = 320, c.height_px = 240;
   c.fx = c.fy = 277.0;
   c.cx = 159.5, c.cy = 119.5;
@@ -20,8 +20,8 @@ inline fiducial::CameraModel small_camera() {
 }
 
 // A distortion-free camera of this size whose view spans `horizontal_fov_deg` across.
-inline fiducial::CameraModel camera(int width_px, int height_px, double horizontal_fov_deg) {
-  fiducial::CameraModel c;
+inline Camera camera(int width_px, int height_px, double horizontal_fov_deg) {
+  Camera c;
   c.width_px = width_px, c.height_px = height_px;
   c.fx = c.fy = width_px / 2.0 / std::tan(horizontal_fov_deg * M_PI / 360);
   c.cx = (width_px - 1) / 2.0, c.cy = (height_px - 1) / 2.0;

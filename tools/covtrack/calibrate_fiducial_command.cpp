@@ -82,7 +82,7 @@ int run_calibrate(const CalibrateArgs& a) {
                                     : fmt::format("{}", fmt::join(names, ", "))),
            2;
   }
-  auto camera = fiducial::load_camera_model(device->calibration);
+  auto camera = load_camera(device->calibration);
   if (!camera) return fmt::print(stderr, "{}: {}\n", kName, camera.error().message), 2;
   auto detector = fiducial::TagDetector::create(device->detector);
   if (!detector) return fmt::print(stderr, "{}: {}\n", kName, detector.error().message), 2;

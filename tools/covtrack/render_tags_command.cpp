@@ -137,7 +137,7 @@ std::optional<PlacedBundle> parse_bundle(const std::string& text, const std::vec
 }
 
 int run_render(const RenderArgs& a) {
-  auto camera = fiducial::load_camera_model(a.camera);
+  auto camera = load_camera(a.camera);
   if (!camera) return fmt::print(stderr, "covtrack render-tags: {}\n", camera.error().message), 2;
   auto family = fiducial::TagFamily::open(a.family);
   if (!family) return fmt::print(stderr, "covtrack render-tags: {}\n", family.error().message), 2;
@@ -196,7 +196,7 @@ int run_render(const RenderArgs& a) {
   formation.gauss_blur_px = a.blur, formation.defocus_radius_px = a.defocus;
   formation.read_noise = a.noise, formation.full_well_e = a.full_well;
   formation.gamma = a.gamma, formation.vignetting = a.vignetting, formation.jpeg_quality = a.jpeg;
-  formation.true_distortion = camera->distortion;  // the lens the calibration describes
+  formation.true_distortion = distortion_vector(*camera);  // the lens the calibration describes
   std::mt19937_64 rng(a.seed);
   for (int f = 0; f < a.frames; ++f) {
     // Each tag and each bundle swings about its own vertical axis, so the frames show motion.

@@ -97,7 +97,7 @@ void finish_lines(osg::Geometry& g) {
 ArScene::ArScene(client::Camera camera, ArSceneOptions options)
     : camera_(std::move(camera)), options_(options), root_(new osg::Group), objects_(new osg::Group) {
   build_background();
-  if (has_distortion(camera_))
+  if (camera_.has_distortion())
     build_lens();
   else
     root_->addChild(objects_);  // drawn by the viewer's camera

@@ -6,11 +6,9 @@
 
 #include <opencv2/calib3d.hpp>
 
-namespace covtrack::ar {
+#include "covtrack/protocol/camera_opencv.hpp"
 
-bool has_distortion(const client::Camera& c) {
-  return c.k1 != 0 || c.k2 != 0 || c.p1 != 0 || c.p2 != 0 || c.k3 != 0;
-}
+namespace covtrack::ar {
 
 LensCanvas lens_canvas(const client::Camera& c) {
   // The image's border, every 8 px, undistorted to normalised coordinates.
@@ -19,10 +17,8 @@ LensCanvas lens_canvas(const client::Camera& c) {
   for (double u = -0.5; u < right; u += 8) border.insert(border.end(), {{u, -0.5}, {u, bottom}});
   for (double v = -0.5; v < bottom; v += 8) border.insert(border.end(), {{-0.5, v}, {right, v}});
   border.insert(border.end(), {{right, -0.5}, {right, bottom}});
-  const cv::Matx33d K(c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
-  const cv::Vec<double, 5> distortion(c.k1, c.k2, c.p1, c.p2, c.k3);
   std::vector<cv::Point2d> normalised;
-  cv::undistortPoints(border, normalised, K, distortion);
+  cv::undistortPoints(border, normalised, camera_matrix(c), distortion_vector(c));
   LensCanvas out;
   out.x_min = out.y_min = std::numeric_limits<double>::infinity();
   out.x_max = out.y_max = -std::numeric_limits<double>::infinity();

@@ -141,7 +141,7 @@ const BundleTag* board_tag(const TagBundle& board, int id) {
 }
 
 // The board's tags in one frame posed under `model` (those the pose refuses are left out).
-std::vector<BundleObservation> pose_tags(const CameraModel& camera, const TagBundle& board, const BoardFrame& frame,
+std::vector<BundleObservation> pose_tags(const Camera& camera, const TagBundle& board, const BoardFrame& frame,
                                          const CornerNoiseModel& model, double ambiguity_chi2) {
   std::vector<BundleObservation> out;
   for (const BoardDetection& d : frame) {
@@ -154,7 +154,7 @@ std::vector<BundleObservation> pose_tags(const CameraModel& camera, const TagBun
 }
 
 // Every tag view of `frames` with two or more other board tags, predicted from them.
-std::vector<Residual> residuals_of(const CameraModel& camera, const TagBundle& board,
+std::vector<Residual> residuals_of(const Camera& camera, const TagBundle& board,
                                    const std::vector<BoardFrame>& frames, const CornerNoiseModel& model,
                                    double ambiguity_chi2, int& frames_used) {
   std::vector<Residual> out;
@@ -187,7 +187,7 @@ std::vector<Residual> residuals_of(const CameraModel& camera, const TagBundle& b
       Eigen::Matrix<double, 8, 6> J;
       for (int k = 0; k < 4; ++k) {
         const Vec3 X_board = me.tag.T_bundle_tag * X[k];
-        const cv::Point2d p = camera.project(placed->T_camera_bundle * X_board);
+        const cv::Point2d p = pinhole_pixel(camera, placed->T_camera_bundle * X_board);
         v.r(2 * k) = unbiased_pose->corners_px[k].x - p.x;
         v.r(2 * k + 1) = unbiased_pose->corners_px[k].y - p.y;
         J.block<2, 6>(2 * k, 0) = point_jacobian(camera, placed->T_camera_bundle, X_board);
@@ -235,7 +235,7 @@ BoardFrame find_board(const cv::Mat& gray, TagDetector& detector, const TagBundl
   return frame;
 }
 
-BoardConsistency board_consistency(const CameraModel& camera, const TagBundle& board,
+BoardConsistency board_consistency(const Camera& camera, const TagBundle& board,
                                    const std::vector<BoardFrame>& frames, const CornerNoiseModel& model,
                                    double ambiguity_chi2) {
   BoardConsistency c;
@@ -260,7 +260,7 @@ BoardConsistency board_consistency(const CameraModel& camera, const TagBundle& b
   return c;
 }
 
-Result<BoardFit> fit_board_calibration(const CameraModel& camera, const TagBundle& board,
+Result<BoardFit> fit_board_calibration(const Camera& camera, const TagBundle& board,
                                        const std::vector<BoardFrame>& frames, const CornerNoiseModel& start,
                                        double ambiguity_chi2) {
   BoardFit fit;

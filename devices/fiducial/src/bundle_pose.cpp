@@ -54,14 +54,14 @@ Result<std::vector<TagCorners>> corners_of_all(const std::vector<BundleObservati
 }
 
 // Whitened residuals of the tags' corners at T; false when a corner is behind the camera.
-bool residuals(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T, Eigen::VectorXd& r) {
+bool residuals(const Camera& cam, const std::vector<TagCorners>& tags, const Pose& T, Eigen::VectorXd& r) {
   r.resize(8 * static_cast<Eigen::Index>(tags.size()));
   for (std::size_t i = 0; i < tags.size(); ++i) {
     Vec8 d;
     for (int k = 0; k < 4; ++k) {
       const Vec3 p = T * tags[i].X_bundle[k];
       if (!(p.z() > 0)) return false;
-      const cv::Point2d u = cam.project(p);
+      const cv::Point2d u = pinhole_pixel(cam, p);
       d(2 * k) = tags[i].measured(2 * k) - u.x, d(2 * k + 1) = tags[i].measured(2 * k + 1) - u.y;
     }
     r.segment<8>(8 * static_cast<Eigen::Index>(i)) = tags[i].whiten * d;
@@ -69,13 +69,13 @@ bool residuals(const CameraModel& cam, const std::vector<TagCorners>& tags, cons
   return true;
 }
 
-double cost_at(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T) {
+double cost_at(const Camera& cam, const std::vector<TagCorners>& tags, const Pose& T) {
   Eigen::VectorXd r;
   return residuals(cam, tags, T, r) ? r.squaredNorm() : std::numeric_limits<double>::infinity();
 }
 
 // J^T Sigma^-1 J at T (the information of the BODY perturbation) and J^T Sigma^-1 r.
-void normal_equations(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T, Mat6& H, Vec6& g) {
+void normal_equations(const Camera& cam, const std::vector<TagCorners>& tags, const Pose& T, Mat6& H, Vec6& g) {
   H.setZero(), g.setZero();
   Eigen::VectorXd r;
   residuals(cam, tags, T, r);
@@ -89,7 +89,7 @@ void normal_equations(const CameraModel& cam, const std::vector<TagCorners>& tag
 }
 
 // Gauss-Newton from T0, halving a step that does not lower the cost.
-Fit gauss_newton(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& T0) {
+Fit gauss_newton(const Camera& cam, const std::vector<TagCorners>& tags, const Pose& T0) {
   Fit f{T0, Mat6::Zero(), cost_at(cam, tags, T0)};
   if (!std::isfinite(f.cost)) return f;
   Mat6 H;
@@ -136,7 +136,7 @@ BundlePose from_one_tag(const BundleObservation& o) {
 }
 
 // Corner-space chi2 between two poses: how well the data tells them apart.
-double separation_chi2(const CameraModel& cam, const std::vector<TagCorners>& tags, const Pose& a, const Pose& b) {
+double separation_chi2(const Camera& cam, const std::vector<TagCorners>& tags, const Pose& a, const Pose& b) {
   Eigen::VectorXd ra, rb;
   if (!residuals(cam, tags, a, ra) || !residuals(cam, tags, b, rb)) return std::numeric_limits<double>::infinity();
   return (ra - rb).squaredNorm();  // the measured corners cancel
@@ -144,7 +144,7 @@ double separation_chi2(const CameraModel& cam, const std::vector<TagCorners>& ta
 
 // A tag's own pose against the pose the other tags give it. Its best solution is the one
 // compared, or its second when only that one agrees: the others then resolved its flip.
-TagAgreement agreement_of(const CameraModel& cam, const BundleObservation& o, const Fit& others, double limit) {
+TagAgreement agreement_of(const Camera& cam, const BundleObservation& o, const Fit& others, double limit) {
   const Pose T_predicted = others.T * o.tag.T_bundle_tag;
   const Mat6 A = se3_adjoint(o.tag.T_bundle_tag.inverse());
   const Mat6 C_predicted = A * others.covariance * A.transpose();
@@ -172,7 +172,7 @@ std::string describe(const TagAgreement& a, double limit) {
 
 }  // namespace
 
-Result<BundlePose> estimate_bundle_pose(const CameraModel& cam, const std::vector<BundleObservation>& observations,
+Result<BundlePose> estimate_bundle_pose(const Camera& cam, const std::vector<BundleObservation>& observations,
                                         double ambiguity_chi2, double consistency_chi2) {
   if (observations.empty()) return fail("no tag of the bundle in view");
   if (observations.size() == 1) return from_one_tag(observations[0]);
@@ -273,7 +273,7 @@ Result<BundlePose> estimate_bundle_pose(const CameraModel& cam, const std::vecto
   return out;
 }
 
-Result<BundlePose> refine_bundle_pose(const CameraModel& cam, const std::vector<BundleObservation>& observations,
+Result<BundlePose> refine_bundle_pose(const Camera& cam, const std::vector<BundleObservation>& observations,
                                       const Pose& start) {
   auto corners = corners_of_all(observations);
   if (!corners) return std::unexpected(corners.error());

@@ -9,9 +9,9 @@
 #include <fmt/ranges.h>
 
 #include "covtrack/devices/device_keys.hpp"
-#include "covtrack/devices/fiducial/camera_model.hpp"
 #include "covtrack/devices/fiducial/frame_source.hpp"
 #include "covtrack/devices/pose_keys.hpp"
+#include "covtrack/protocol/camera.hpp"
 #include "covtrack/protocol/channels.hpp"
 
 namespace covtrack::fiducial {
@@ -222,7 +222,7 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
   }
   c.calibration = relative_to_config(r.string("calibration"), r.file());
   r.resource("calibration", [file = c.calibration]() -> Result<void> {
-    if (auto camera = load_camera_model(file); !camera) return std::unexpected(camera.error());
+    if (auto camera = load_camera(file); !camera) return std::unexpected(camera.error());
     return {};
   });
   c.detector.family = r.string("family", "tag36h11");

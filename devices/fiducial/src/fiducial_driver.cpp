@@ -47,7 +47,7 @@ class FiducialDriver final : public Driver {
 
  private:
   Result<void> run_checked(SampleSink& sink, std::stop_token stop) {
-    auto camera = load_camera_model(config_.calibration);
+    auto camera = load_camera(config_.calibration);
     if (!camera) return std::unexpected(camera.error());
     camera_ = *camera;
     auto detector = TagDetector::create(config_.detector);
@@ -185,7 +185,7 @@ class FiducialDriver final : public Driver {
 
   FiducialConfig config_;
   DriverClock& clock_;
-  CameraModel camera_;
+  Camera camera_;
   std::unique_ptr<TagDetector> detector_;
   std::uint64_t frames_published_ = 0;  // frames considered for publish_images (every n-th goes)
   // Every tag the driver poses: its size and place on its bundle, if it is in one.

@@ -36,13 +36,13 @@ cv::Point2d cross(const Line& a, const Line& b) {
 
 }  // namespace
 
-std::array<cv::Point2d, 4> straight_fit_corner_offsets(const CameraModel& cam,
+std::array<cv::Point2d, 4> straight_fit_corner_offsets(const Camera& cam,
                                                        const std::array<cv::Point2d, 4>& corners_px) {
   std::array<cv::Point2d, 4> offsets{};
   if (!cam.has_distortion()) return offsets;
   // The corners on the ideal (pinhole) image, as normalised rays, where edges are straight.
   std::vector<cv::Point2d> distorted(corners_px.begin(), corners_px.end()), ideal;
-  cv::undistortPoints(distorted, ideal, cam.K(), cam.distortion);
+  cv::undistortPoints(distorted, ideal, camera_matrix(cam), distortion_vector(cam));
   std::vector<cv::Point3d> rays;
   for (int e = 0; e < 4; ++e)
     for (int j = 1; j <= kSamplesPerEdge; ++j) {
@@ -52,7 +52,7 @@ std::array<cv::Point2d, 4> straight_fit_corner_offsets(const CameraModel& cam,
     }
   for (const auto& q : ideal) rays.emplace_back(q.x, q.y, 1);
   std::vector<cv::Point2d> image;
-  cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), cam.K(), cam.distortion, image);
+  cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera_matrix(cam), distortion_vector(cam), image);
   std::array<Line, 4> lines;
   for (int e = 0; e < 4; ++e)
     lines[static_cast<std::size_t>(e)] = fit_line({image.begin() + e * kSamplesPerEdge,

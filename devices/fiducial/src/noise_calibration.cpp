@@ -25,7 +25,7 @@ Pose jittered(const CalibrationView& v, std::mt19937_64& rng) {
 }
 
 ViewDraw one_draw(TagDetector& detector, const CalibrationView& view, std::mt19937_64& rng) {
-  const CameraModel& camera = view.camera;
+  const Camera& camera = view.camera;
   ViewDraw d;
   RenderedTag tag = view.tag;
   tag.T_camera_tag = d.T_camera_tag_true = jittered(view, rng);
@@ -36,7 +36,7 @@ ViewDraw one_draw(TagDetector& detector, const CalibrationView& view, std::mt199
     // Where the real lens puts them: through the true distortion, not the camera model's.
     std::vector<cv::Point3d> rays;
     for (const auto& p : truth) rays.emplace_back((p.x - camera.cx) / camera.fx, (p.y - camera.cy) / camera.fy, 1);
-    cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.K(), lens, truth);
+    cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera_matrix(camera), lens, truth);
   }
   for (std::size_t k = 0; k < 4; ++k) d.truth_px[k] = truth[k];
   // The detection of this tag, if any: the one nearest the truth with its id (a family

@@ -60,15 +60,15 @@ void add_polygon(cv::Mat& image, const Polygon& poly, float value) {
 }
 
 // The tag-plane rectangle [x0, x1] x [y0, y1] (m) in image pixels, through the pinhole.
-Polygon project_rect(const CameraModel& camera, const Pose& T, double x0, double y0, double x1,
+Polygon project_rect(const Camera& camera, const Pose& T, double x0, double y0, double x1,
                      double y1) {
   Polygon out;
   for (const auto& [x, y] : {std::pair{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}})
-    out.push_back(camera.project(T * Vec3(x, y, 0)));
+    out.push_back(pinhole_pixel(camera, T * Vec3(x, y, 0)));
   return out;
 }
 
-cv::Mat analytic_radiance(const CameraModel& camera, const TagFamily& family,
+cv::Mat analytic_radiance(const Camera& camera, const TagFamily& family,
                           const std::vector<RenderedTag>& tags, const ImageFormation& f) {
   cv::Mat image(camera.height_px, camera.width_px, CV_32F, cv::Scalar(f.background));
   const int margin = std::max(0, f.margin_cells);
@@ -105,12 +105,12 @@ cv::Mat analytic_radiance(const CameraModel& camera, const TagFamily& family,
 
 // Moves a pinhole image to where a lens with `distortion` puts it: each output pixel
 // reads the ideal image at its undistorted position.
-cv::Mat distort(const cv::Mat& ideal, const CameraModel& camera, const cv::Mat& distortion) {
+cv::Mat distort(const cv::Mat& ideal, const Camera& camera, const cv::Mat& distortion) {
   // The map depends only on the camera and the lens, and is slow to make (every pixel
   // undistorted iteratively): kept for the next frame of the same camera.
   struct Cached { cv::Size size; cv::Matx33d K; cv::Mat distortion, map; };
   thread_local Cached cache;
-  const bool same = cache.size == ideal.size() && cache.K == camera.K() &&
+  const bool same = cache.size == ideal.size() && cache.K == camera_matrix(camera) &&
                     cache.distortion.size() == distortion.size() &&
                     cv::norm(cache.distortion, distortion, cv::NORM_INF) == 0;
   if (!same) {
@@ -119,8 +119,8 @@ cv::Mat distort(const cv::Mat& ideal, const CameraModel& camera, const cv::Mat& 
     for (int r = 0; r < ideal.rows; ++r)
       for (int c = 0; c < ideal.cols; ++c) pixels.emplace_back(static_cast<float>(c), static_cast<float>(r));
     std::vector<cv::Point2f> ideal_at;
-    cv::undistortPoints(pixels, ideal_at, camera.K(), distortion, cv::noArray(), camera.K());
-    cache = {ideal.size(), camera.K(), distortion.clone(), cv::Mat(ideal.size(), CV_32FC2, ideal_at.data()).clone()};
+    cv::undistortPoints(pixels, ideal_at, camera_matrix(camera), distortion, cv::noArray(), camera_matrix(camera));
+    cache = {ideal.size(), camera_matrix(camera), distortion.clone(), cv::Mat(ideal.size(), CV_32FC2, ideal_at.data()).clone()};
   }
   cv::Mat out;
   cv::remap(ideal, out, cache.map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
@@ -152,7 +152,7 @@ double pixel_coverage(const std::vector<cv::Point2d>& poly, int x, int y) {
                    0, x + 0.5, true));
 }
 
-cv::Mat tag_radiance(const CameraModel& camera, const TagFamily& family,
+cv::Mat tag_radiance(const Camera& camera, const TagFamily& family,
                      const std::vector<RenderedTag>& tags, const ImageFormation& f) {
   if (f.rasteriser == Rasteriser::AnalyticArea) return analytic_radiance(camera, family, tags, f);
   RenderLook look;
@@ -161,7 +161,7 @@ cv::Mat tag_radiance(const CameraModel& camera, const TagFamily& family,
   return render_tags(camera, family, tags, look);
 }
 
-cv::Mat form_image(const CameraModel& camera, const TagFamily& family,
+cv::Mat form_image(const Camera& camera, const TagFamily& family,
                    const std::vector<RenderedTag>& tags, const ImageFormation& f,
                    std::mt19937_64& rng) {
   cv::Mat linear = tag_radiance(camera, family, tags, f) * f.exposure;

@@ -37,13 +37,13 @@ Pose pose_of(const cv::Mat& rvec, const cv::Mat& tvec) {
   return T;
 }
 
-double sse(const CameraModel& cam, const Pose& T, const std::array<Vec3, 4>& object,
+double sse(const Camera& cam, const Pose& T, const std::array<Vec3, 4>& object,
            const std::vector<cv::Point2d>& image) {
   double s = 0;
   for (int i = 0; i < 4; ++i) {
     const Vec3 p = T * object[i];
     if (p.z() <= 0) return std::numeric_limits<double>::infinity();
-    const cv::Point2d d = cam.project(p) - image[i];
+    const cv::Point2d d = pinhole_pixel(cam, p) - image[i];
     s += d.dot(d);
   }
   return s;
@@ -112,7 +112,7 @@ Eigen::Matrix<double, 8, 8> corner_covariance(const std::array<cv::Point2d, 4>& 
   return cov;
 }
 
-Eigen::Matrix<double, 2, 6> point_jacobian(const CameraModel& cam, const Pose& T, const Vec3& X) {
+Eigen::Matrix<double, 2, 6> point_jacobian(const Camera& cam, const Pose& T, const Vec3& X) {
   const Vec3 p = T * X;
   // T Exp(xi) X ~ T (X + rho + phi x X): dp/dxi = R [I, -[X]x].
   const Mat3 R = T.rotation();
@@ -124,7 +124,7 @@ Eigen::Matrix<double, 2, 6> point_jacobian(const CameraModel& cam, const Pose& T
   return du * dp;
 }
 
-CornerJacobian corner_jacobian(const CameraModel& cam, const Pose& T, double size_m) {
+CornerJacobian corner_jacobian(const Camera& cam, const Pose& T, double size_m) {
   CornerJacobian J;
   const auto corners = tag_corner_points(size_m);
   for (int i = 0; i < 4; ++i) J.block<2, 6>(2 * i, 0) = point_jacobian(cam, T, corners[i]);
@@ -143,7 +143,7 @@ Mat6 pose_covariance(const CornerJacobian& J, const Eigen::Matrix<double, 8, 8>&
   return (cov + cov.transpose()) / 2;
 }
 
-Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::Point2d, 4>& c,
+Result<TagPose> estimate_tag_pose(const Camera& cam, const std::array<cv::Point2d, 4>& c,
                                   double size_m, const CornerNoise& noise, double ambiguity_chi2) {
   const double sigma = noise.sigma_px;
   for (const auto& p : c)
@@ -160,7 +160,7 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
   const auto bend = straight_fit_corner_offsets(cam, moved);
   for (std::size_t k = 0; k < 4; ++k) moved[k] -= bend[k];
   std::vector<cv::Point2d> image(moved.begin(), moved.end());
-  if (cam.has_distortion()) cv::undistortPoints(image, image, cam.K(), cam.distortion, cv::noArray(), cam.K());
+  if (cam.has_distortion()) cv::undistortPoints(image, image, camera_matrix(cam), distortion_vector(cam), cv::noArray(), camera_matrix(cam));
   const double area = std::abs((image[2] - image[0]).cross(image[3] - image[1])) / 2;
   if (!(area > 4)) return fail(fmt::format("tag quad is degenerate (area {:.2f} px^2)", area));
   const Eigen::Matrix<double, 8, 8> corner_cov =
@@ -169,7 +169,7 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
   const auto object = tag_corner_points(size_m);
   std::vector<cv::Point3d> obj;
   for (const Vec3& X : object) obj.emplace_back(X.x(), X.y(), X.z());
-  const cv::Mat K(cam.K());
+  const cv::Mat K(camera_matrix(cam));
   std::vector<cv::Mat> rvecs, tvecs;
   std::vector<PoseSolution> solutions, unrefined;
   try {
@@ -209,8 +209,8 @@ Result<TagPose> estimate_tag_pose(const CameraModel& cam, const std::array<cv::P
     // (systematic terms included): what the data can tell apart.
     Eigen::Matrix<double, 8, 1> d;
     for (int i = 0; i < 4; ++i) {
-      const cv::Point2d step = cam.project(solutions[1].T_camera_tag * object[i]) -
-                               cam.project(out.best.T_camera_tag * object[i]);
+      const cv::Point2d step = pinhole_pixel(cam, solutions[1].T_camera_tag * object[i]) -
+                               pinhole_pixel(cam, out.best.T_camera_tag * object[i]);
       d(2 * i) = step.x, d(2 * i + 1) = step.y;
     }
     out.ambiguity_chi2 = d.dot(corner_cov.ldlt().solve(d));

@@ -13,24 +13,24 @@ namespace {
 constexpr int kTexelsPerCell = 24;
 
 // Tag-plane point (x, y, 1) to full-resolution image pixel (OpenCV convention).
-cv::Matx33d plane_to_image(const CameraModel& camera, const Pose& T_camera_tag) {
+cv::Matx33d plane_to_image(const Camera& camera, const Pose& T_camera_tag) {
   const Mat3 R = T_camera_tag.rotation();
   const Vec3 t = T_camera_tag.translation();
   const cv::Matx33d Rt(R(0, 0), R(0, 1), t.x(), R(1, 0), R(1, 1), t.y(), R(2, 0), R(2, 1), t.z());
-  return camera.K() * Rt;
+  return camera_matrix(camera) * Rt;
 }
 
 }  // namespace
 
-std::vector<cv::Point2d> projected_corners(const CameraModel& camera, const RenderedTag& tag) {
+std::vector<cv::Point2d> projected_corners(const Camera& camera, const RenderedTag& tag) {
   const double h = tag.size_m / 2;
   const Vec3 corners[4] = {{-h, h, 0}, {h, h, 0}, {h, -h, 0}, {-h, -h, 0}};
   std::vector<cv::Point2d> out;
-  for (const Vec3& c : corners) out.push_back(camera.project(tag.T_camera_tag * c));
+  for (const Vec3& c : corners) out.push_back(pinhole_pixel(camera, tag.T_camera_tag * c));
   return out;
 }
 
-cv::Mat render_tags(const CameraModel& camera, const TagFamily& family,
+cv::Mat render_tags(const Camera& camera, const TagFamily& family,
                     const std::vector<RenderedTag>& tags, const RenderLook& look) {
   cv::Mat image(camera.height_px, camera.width_px, CV_32F, cv::Scalar(look.background));
   const int S = std::max(1, look.supersample);
@@ -49,7 +49,7 @@ cv::Mat render_tags(const CameraModel& camera, const TagFamily& family,
       for (double sy : {-1.0, 1.0}) {
         const Vec3 p = tag.T_camera_tag * Vec3(sx * half_total_m, sy * half_total_m, 0);
         if (p.z() < 1e-3) in_front = false;
-        else outline.push_back(camera.project(p));
+        else outline.push_back(pinhole_pixel(camera, p));
       }
     if (!in_front) continue;
     double u0 = 1e18, v0 = 1e18, u1 = -1e18, v1 = -1e18;

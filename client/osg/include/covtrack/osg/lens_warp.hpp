@@ -18,9 +18,6 @@ struct LensCanvas {
   double x_min = 0, x_max = 0, y_min = 0, y_max = 0;
 };
 
-// True when the camera's model has any distortion coefficient.
-bool has_distortion(const client::Camera& camera);
-
 // The canvas covering every pixel of the camera's image once undistorted (cv::undistortPoints
 // on the border), within the fold, at the image's pixel density; at most 4096 px a side.
 LensCanvas lens_canvas(const client::Camera& camera);

@@ -25,9 +25,9 @@
 #include <vector>
 
 #include "covtrack/devices/fiducial/bundle_pose.hpp"
-#include "covtrack/devices/fiducial/camera_model.hpp"
 #include "covtrack/devices/fiducial/corner_noise.hpp"
 #include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "covtrack/protocol/camera_opencv.hpp"
 #include "covtrack/protocol/result.hpp"
 
 namespace covtrack::fiducial {
@@ -73,12 +73,12 @@ BoardFrame find_board(const cv::Mat& gray, TagDetector& detector, const TagBundl
 // Fits this camera's model from `frames` of `board`, starting from `start` (the model the
 // device has now). Fails when fewer than 30 residuals are usable (too few frames with three
 // tags or more).
-Result<BoardFit> fit_board_calibration(const CameraModel& camera, const TagBundle& board,
+Result<BoardFit> fit_board_calibration(const Camera& camera, const TagBundle& board,
                                        const std::vector<BoardFrame>& frames, const CornerNoiseModel& start,
                                        double ambiguity_chi2 = 40.0);
 
 // The consistency of `frames` under `model` (as reported before and after the fit).
-BoardConsistency board_consistency(const CameraModel& camera, const TagBundle& board,
+BoardConsistency board_consistency(const Camera& camera, const TagBundle& board,
                                    const std::vector<BoardFrame>& frames, const CornerNoiseModel& model,
                                    double ambiguity_chi2 = 40.0);
 

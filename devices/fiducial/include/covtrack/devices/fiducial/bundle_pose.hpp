@@ -32,8 +32,8 @@
 #include <string>
 #include <vector>
 
-#include "covtrack/devices/fiducial/camera_model.hpp"
 #include "covtrack/devices/fiducial/tag_pose.hpp"
+#include "covtrack/protocol/camera_opencv.hpp"
 #include "covtrack/protocol/result.hpp"
 #include "covtrack/protocol/se3.hpp"
 
@@ -82,13 +82,13 @@ struct BundlePose {
 // limit of agreement is measured (devices/fiducial/README.md, "Tag bundles"): the
 // 6-dof chi-square's 99.9% quantile, 22.5, called 11% of consistent rendered bundles
 // DEGRADED, as single tags' own covariances have heavier tails than the model's.
-Result<BundlePose> estimate_bundle_pose(const CameraModel& camera, const std::vector<BundleObservation>& observations,
+Result<BundlePose> estimate_bundle_pose(const Camera& camera, const std::vector<BundleObservation>& observations,
                                         double ambiguity_chi2 = 40.0, double consistency_chi2 = 40.0);
 
 // The pose from all of `observations`' corners by Gauss-Newton from `start`, with its
 // covariance, and nothing else: no search for a second minimum, no agreement check. For
 // fits repeated from a known good start (the calibration leaves each tag out in turn).
-Result<BundlePose> refine_bundle_pose(const CameraModel& camera, const std::vector<BundleObservation>& observations,
+Result<BundlePose> refine_bundle_pose(const Camera& camera, const std::vector<BundleObservation>& observations,
                                       const Pose& start);
 
 }  // namespace covtrack::fiducial

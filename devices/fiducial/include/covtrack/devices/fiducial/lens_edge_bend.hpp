@@ -8,14 +8,14 @@
 
 #include <opencv2/core.hpp>
 
-#include "covtrack/devices/fiducial/camera_model.hpp"
+#include "covtrack/protocol/camera_opencv.hpp"
 
 namespace covtrack::fiducial {
 
 // For a quad whose corners are `corners_px` in the distorted image: how far the crossings
 // of straight lines fitted along each bent edge lie from the corners (px, per corner,
 // AprilTag's order). Zero without distortion.
-std::array<cv::Point2d, 4> straight_fit_corner_offsets(const CameraModel& camera,
+std::array<cv::Point2d, 4> straight_fit_corner_offsets(const Camera& camera,
                                                        const std::array<cv::Point2d, 4>& corners_px);
 
 }  // namespace covtrack::fiducial

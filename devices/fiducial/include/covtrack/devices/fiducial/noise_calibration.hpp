@@ -16,7 +16,7 @@ namespace covtrack::fiducial {
 // One view: a tag, the camera model the driver is given (its pinhole part also renders)
 // and the camera's image formation (which may have a lens unlike the model's).
 struct CalibrationView {
-  CameraModel camera;
+  Camera camera;
   RenderedTag tag;
   ImageFormation formation;
   // Each draw moves the tag by up to this much (m, rad per axis), so that the

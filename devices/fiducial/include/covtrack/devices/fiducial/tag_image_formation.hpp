@@ -12,9 +12,9 @@
 
 #include <opencv2/core.hpp>
 
-#include "covtrack/devices/fiducial/camera_model.hpp"
 #include "covtrack/devices/fiducial/tag_family.hpp"
 #include "covtrack/devices/fiducial/tag_renderer.hpp"
+#include "covtrack/protocol/camera_opencv.hpp"
 
 namespace covtrack::fiducial {
 
@@ -46,11 +46,11 @@ struct ImageFormation {
 };
 
 // The linear radiance of the tags over a flat background (CV_32F), sharp, pinhole.
-cv::Mat tag_radiance(const CameraModel& camera, const TagFamily& family,
+cv::Mat tag_radiance(const Camera& camera, const TagFamily& family,
                      const std::vector<RenderedTag>& tags, const ImageFormation& formation);
 
 // The 8-bit frame a camera with this formation delivers.
-cv::Mat form_image(const CameraModel& camera, const TagFamily& family,
+cv::Mat form_image(const Camera& camera, const TagFamily& family,
                    const std::vector<RenderedTag>& tags, const ImageFormation& formation,
                    std::mt19937_64& rng);
 

@@ -22,7 +22,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "covtrack/devices/fiducial/camera_model.hpp"
+#include "covtrack/protocol/camera_opencv.hpp"
 #include "covtrack/protocol/result.hpp"
 #include "covtrack/protocol/se3.hpp"
 
@@ -54,10 +54,10 @@ std::array<Vec3, 4> tag_corner_points(double size_m);
 
 // d(pixel)/d(xi) of the point X (in the frame of T_camera_frame) under the pinhole
 // projection, for the BODY perturbation T_camera_frame * Exp(xi).
-Eigen::Matrix<double, 2, 6> point_jacobian(const CameraModel& camera, const Pose& T_camera_frame, const Vec3& X);
+Eigen::Matrix<double, 2, 6> point_jacobian(const Camera& camera, const Pose& T_camera_frame, const Vec3& X);
 
 // d(corner pixels)/d(xi) at T_camera_tag, rows u0 v0 u1 v1 ..., pinhole projection.
-CornerJacobian corner_jacobian(const CameraModel& camera, const Pose& T_camera_tag, double size_m);
+CornerJacobian corner_jacobian(const Camera& camera, const Pose& T_camera_tag, double size_m);
 
 // Per edge (corner k to k + 1): its outward shift (px) at its start and at its end.
 using EdgeShifts = std::array<std::array<double, 2>, 4>;
@@ -97,7 +97,7 @@ Mat6 pose_covariance(const CornerJacobian& J, const Eigen::Matrix<double, 8, 8>&
 // Corner pixels are undistorted with the camera's distortion first; the noise model is
 // applied to the undistorted corners. Fails on degenerate input (non-finite corners,
 // a collapsed quad) or when no pose is found.
-Result<TagPose> estimate_tag_pose(const CameraModel& camera,
+Result<TagPose> estimate_tag_pose(const Camera& camera,
                                   const std::array<cv::Point2d, 4>& corners_px, double size_m,
                                   const CornerNoise& noise, double ambiguity_chi2 = 40.0);
 

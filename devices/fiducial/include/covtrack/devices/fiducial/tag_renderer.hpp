@@ -8,8 +8,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "covtrack/devices/fiducial/camera_model.hpp"
 #include "covtrack/devices/fiducial/tag_family.hpp"
+#include "covtrack/protocol/camera_opencv.hpp"
 #include "covtrack/protocol/se3.hpp"
 
 namespace covtrack::fiducial {
@@ -32,7 +32,7 @@ struct RenderLook {
 
 // The noise-free image (CV_32F grey levels). Tags behind the camera are skipped.
 // The camera's distortion is ignored: render through a distortion-free calibration.
-cv::Mat render_tags(const CameraModel& camera, const TagFamily& family,
+cv::Mat render_tags(const Camera& camera, const TagFamily& family,
                     const std::vector<RenderedTag>& tags, const RenderLook& look);
 
 // The 8-bit frame a sensor would deliver: clean + N(0, sigma^2) noise, rounded, clipped.
@@ -40,6 +40,6 @@ cv::Mat add_sensor_noise(const cv::Mat& clean, double noise_sigma, std::mt19937_
 
 // Where the tag's four detected corners project, in the detector's order (AprilTag 3:
 // tag-frame (-s/2, +s/2), (+s/2, +s/2), (+s/2, -s/2), (-s/2, -s/2)).
-std::vector<cv::Point2d> projected_corners(const CameraModel& camera, const RenderedTag& tag);
+std::vector<cv::Point2d> projected_corners(const Camera& camera, const RenderedTag& tag);
 
 }  // namespace covtrack::fiducial

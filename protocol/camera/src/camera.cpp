@@ -1,4 +1,5 @@
-#include "covtrack/client/camera.hpp"
+#include "covtrack/protocol/camera.hpp"
+#include "covtrack/protocol/camera_opencv.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -10,7 +11,7 @@
 
 #include <string>
 
-namespace covtrack::client {
+namespace covtrack {
 
 Vec2 Camera::project(const Vec3& p, Mat23* J_pixel_point) const {
   const double iz = 1.0 / p.z();
@@ -203,4 +204,21 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
   return cam;
 }
 
-}  // namespace covtrack::client
+Result<void> save_camera(const Camera& camera, const std::filesystem::path& path) {
+  try {
+    cv::FileStorage fs(path.string(), cv::FileStorage::WRITE);
+    if (!fs.isOpened()) return fail(fmt::format("{}: cannot write", path.string()));
+    fs << "image_width" << camera.width_px << "image_height" << camera.height_px;
+    fs << "camera_matrix" << cv::Mat(camera_matrix(camera));
+    fs << "distortion_coefficients" << distortion_vector(camera);
+    if (!camera.intrinsic_sigmas_px.isZero())
+      fs << "intrinsics_std_deviations"
+         << cv::Mat(cv::Vec4d(camera.intrinsic_sigmas_px[0], camera.intrinsic_sigmas_px[1],
+                              camera.intrinsic_sigmas_px[2], camera.intrinsic_sigmas_px[3]));
+  } catch (const cv::Exception& e) {
+    return fail(fmt::format("{}: cannot write: {}", path.string(), e.what()));
+  }
+  return {};
+}
+
+}  // namespace covtrack
