@@ -12,13 +12,20 @@ set(COVTRACK_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/covtrack)
 set_target_properties(covtrack_protocol PROPERTIES EXPORT_NAME protocol)
 set_target_properties(covtrack_camera PROPERTIES EXPORT_NAME camera)
 set_target_properties(covtrack_client PROPERTIES EXPORT_NAME client)
+# The client's parts (client/CMakeLists.txt), which covtrack::client links.
+foreach(part streams graph regions widgets)
+  set_target_properties(covtrack_client_${part} PROPERTIES EXPORT_NAME client_${part})
+endforeach()
 set_target_properties(covtrack_lcmlog PROPERTIES EXPORT_NAME log)
 
-install(TARGETS covtrack_protocol covtrack_camera covtrack_client covtrack_lcmlog
+install(TARGETS covtrack_protocol covtrack_camera covtrack_client_streams covtrack_client_graph covtrack_client_regions
+                covtrack_client_widgets covtrack_client covtrack_lcmlog
         EXPORT covtrackTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(DIRECTORY protocol/include/ protocol/camera/include/ client/include/ tools/lcmlog/include/
+install(DIRECTORY protocol/include/ protocol/camera/include/ client/streams/include/ client/graph/include/
+                  client/regions/include/ client/widgets/include/ client/ar_view/include/
+                  tools/lcmlog/include/
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT dev)
 # lcm-gen's headers (covtrack/pose_cov_t.hpp, ...), which the public headers include.
 install(DIRECTORY ${PROJECT_BINARY_DIR}/protocol/lcmgen/covtrack

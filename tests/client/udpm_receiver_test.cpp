@@ -15,7 +15,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "raw_datagram.hpp"
-#include "udpm_receiver.hpp"  // client/src: the receiver is internal to the Subscriber
+#include "udpm_receiver.hpp"  // client/streams/src: the receiver is internal to the Subscriber
 
 using namespace covtrack;
 using namespace std::chrono_literals;

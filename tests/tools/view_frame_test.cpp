@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "covtrack/client/convex_polygon.hpp"
+#include "covtrack/client/regions.hpp"
 #include "covtrack/scene/scene_graph.hpp"
 #include "region_drawing.hpp"
 #include "regions_report.hpp"

@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "covtrack/client/label_placer.hpp"
+#include "covtrack/client/regions.hpp"
 #include "regions_report.hpp"
 #include "view_widgets.hpp"
 

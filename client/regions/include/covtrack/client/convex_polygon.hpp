@@ -1,9 +1,9 @@
 #pragma once
-// Convex polygon operations the widgets need beyond regions.hpp: intersection in linear
-// time, centroid. Polygons as in regions.hpp: counter-clockwise (positive signed area), no
+// Convex polygon operations the widgets need beyond polygon.hpp: intersection in linear
+// time, centroid. Polygons as in polygon.hpp: counter-clockwise (positive signed area), no
 // repeated closing vertex. (The slow reference the intersection is tested against is in
 // tests/support.)
-#include "covtrack/client/regions.hpp"
+#include "covtrack/client/polygon.hpp"
 
 namespace covtrack::client {
 

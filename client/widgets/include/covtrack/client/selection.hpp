@@ -12,6 +12,7 @@
 #include <span>
 #include <vector>
 
+#include "covtrack/client/regions.hpp"
 #include "covtrack/client/screen_box.hpp"
 
 namespace covtrack::client {

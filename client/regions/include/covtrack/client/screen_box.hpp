@@ -1,7 +1,7 @@
 #pragma once
 // Axis-aligned boxes in pixels (labels, selection targets, the screen) and their tests
 // against each other and against convex polygons.
-#include "covtrack/client/regions.hpp"
+#include "covtrack/client/polygon.hpp"
 
 namespace covtrack::client {
 

@@ -35,34 +35,16 @@
 //    one last step from 1e-3 px (quadratic convergence lands far closer; a test checks
 //    1e-5 px); the line is then moved to the smaller support, so what is left of that
 //    error only shrinks the region.
-// Polygons are counter-clockwise in (u, v) arithmetic (positive signed area), no repeated
-// closing vertex.
+// Polygons (polygon.hpp) are counter-clockwise in (u, v) arithmetic (positive signed
+// area), no repeated closing vertex.
 #include <span>
 #include <vector>
 
 #include "covtrack/client/assessment.hpp"
+#include "covtrack/client/polygon.hpp"
 #include "covtrack/client/projection.hpp"
 
 namespace covtrack::client {
-
-using Polygon = std::vector<Vec2>;
-
-// ---- Polygons (region_polygon.cpp) ----
-// Counter-clockwise from the lowest x (of those, the lowest y); collinear points dropped.
-// Andrew's monotone chain, or for up to 8 points on a CPU with AVX2 each point's successor
-// found side by side (the same hull, without a sort). Indices into `points`.
-std::vector<int> convex_hull_indices(std::span<const Vec2> points);
-// The same into `hull` (no allocation once its capacity suffices).
-void convex_hull_indices(std::span<const Vec2> points, std::vector<int>& hull);
-Polygon convex_hull(std::span<const Vec2> points);
-// The part of a convex polygon with normal . x <= offset.
-Polygon clip_half_plane(const Polygon& convex, const Vec2& normal, double offset);
-// The same into `out`, which has room for convex.size() + 1 points; returns the count.
-std::size_t clip_half_plane(std::span<const Vec2> convex, const Vec2& normal, double offset,
-                            Vec2* out);
-// Inside or within tolerance_px of a convex polygon.
-bool polygon_contains(const Polygon& convex, const Vec2& point, double tolerance_px = 1e-9);
-double polygon_area(const Polygon& polygon);
 
 // ---- Ellipses (region_ellipse.cpp) ----
 // Smallest N in [min_sides, max_sides] with a (1/cos(pi/N) - 1) <= max_error_px.

@@ -5,7 +5,7 @@
 // shortcut the line with both on its inner side.
 #include <vector>
 
-#include "covtrack/client/regions.hpp"
+#include "covtrack/client/projection.hpp"
 
 namespace covtrack::client {
 

@@ -3,6 +3,7 @@
 // object's inner and outer lines are solved together (compute_object_regions).
 #include <span>
 
+#include "covtrack/client/regions.hpp"
 #include "region_tangents.hpp"
 
 namespace covtrack::client {
