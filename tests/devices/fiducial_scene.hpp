@@ -5,7 +5,7 @@
 #include <random>
 
 #include "covtrack/devices/fiducial/camera_model.hpp"
-#include "covtrack/devices/fiducial/tag_image_formation.hpp"
+#include "covtrack/emulators/fiducial/tag_image_formation.hpp"
 #include "covtrack/protocol/se3.hpp"
 
 namespace covtrack::test {

@@ -15,7 +15,7 @@
 
 #include "commands.hpp"
 #include "covtrack/program/command_line.hpp"
-#include "covtrack/emulate6dof/emulator.hpp"
+#include "covtrack/emulators/serial6dof/emulator.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 #include "covtrack/protocol/pose_message.hpp"

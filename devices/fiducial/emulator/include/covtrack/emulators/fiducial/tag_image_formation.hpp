@@ -14,7 +14,7 @@
 
 #include "covtrack/devices/fiducial/camera_model.hpp"
 #include "covtrack/devices/fiducial/tag_family.hpp"
-#include "covtrack/devices/fiducial/tag_renderer.hpp"
+#include "covtrack/emulators/fiducial/tag_renderer.hpp"
 
 namespace covtrack::fiducial {
 

@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/tag_image_formation.hpp"
+#include "covtrack/emulators/fiducial/tag_image_formation.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "covtrack/emulate6dof/emulator.hpp"
+#include "covtrack/emulators/serial6dof/emulator.hpp"
 
 #include <chrono>
 #include <numbers>

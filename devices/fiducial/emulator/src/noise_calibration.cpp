@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/noise_calibration.hpp"
+#include "covtrack/emulators/fiducial/noise_calibration.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "covtrack/devices/serial6dof/record_encoder.hpp"
-#include "covtrack/emulate6dof/emulator.hpp"
+#include "covtrack/emulators/serial6dof/emulator.hpp"
 
 namespace covtrack::emulate6dof {
 

@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/tag_renderer.hpp"
+#include "covtrack/emulators/fiducial/tag_renderer.hpp"
 
 #include <algorithm>
 #include <cmath>
