@@ -14,12 +14,12 @@
 #include <thread>
 
 #include "capture_sink.hpp"
-#include "covtrack/devices/vrpn/message_names.hpp"
-#include "covtrack/devices/vrpn/session.hpp"
-#include "covtrack/devices/vrpn/socket.hpp"
-#include "covtrack/devices/vrpn/tracker_report.hpp"
 #include "covtrack/devices/vrpn/vrpn_driver.hpp"
 #include "covtrack/protocol/clock.hpp"
+#include "covtrack/vrpn/message_names.hpp"
+#include "covtrack/vrpn/session.hpp"
+#include "covtrack/vrpn/socket.hpp"
+#include "covtrack/vrpn/tracker_report.hpp"
 
 using namespace covtrack;
 using namespace covtrack::vrpn;

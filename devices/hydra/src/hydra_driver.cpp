@@ -6,10 +6,10 @@
 #include <hidapi/hidapi.h>
 
 #include "covtrack/devices/file_kind.hpp"
-#include "covtrack/devices/hydra/hydra_report.hpp"
-#include "covtrack/devices/hydra/hydra_stream.hpp"
 #include "covtrack/devices/valid_frame_watchdog.hpp"
 #include "covtrack/protocol/clock.hpp"
+#include "hydra_report.hpp"
+#include "hydra_stream.hpp"
 
 namespace covtrack::hydra {
 namespace {

@@ -4,8 +4,9 @@
 #include <memory>
 #include <span>
 
-#include "covtrack/devices/serial6dof/serial6dof_config.hpp"
+#include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 #include "device_link.hpp"
+#include "tracker_record.hpp"
 
 namespace covtrack::serial6dof {
 

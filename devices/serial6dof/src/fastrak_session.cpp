@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "device_session.hpp"
+#include "fastrak_decoder.hpp"
 
 namespace covtrack::serial6dof {
 namespace {

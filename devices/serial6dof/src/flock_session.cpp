@@ -3,8 +3,8 @@
 // the units), P 35 g (group mode), ] per bird (POSITION/QUATERNION), @ (stream).
 #include <fmt/format.h>
 
-#include "covtrack/devices/serial6dof/flock_decoder.hpp"
 #include "device_session.hpp"
+#include "flock_decoder.hpp"
 
 namespace covtrack::serial6dof {
 namespace {

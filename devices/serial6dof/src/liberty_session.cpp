@@ -5,6 +5,7 @@
 
 #include "device_session.hpp"
 #include "float_le.hpp"
+#include "liberty_decoder.hpp"
 
 namespace covtrack::serial6dof {
 namespace {

@@ -5,8 +5,8 @@
 #include <memory>
 #include <vector>
 
-#include "covtrack/devices/serial6dof/record_encoder.hpp"
 #include "covtrack/emulators/serial6dof/emulator.hpp"
+#include "record_encoder.hpp"
 
 namespace covtrack::emulate6dof {
 

@@ -4,8 +4,8 @@
 #include <numbers>
 #include <random>
 
+#include "covariance_model.hpp"
 #include "covtrack/devices/serial/pseudo_terminal.hpp"
-#include "covtrack/devices/serial6dof/covariance_model.hpp"
 #include "covtrack/protocol/se3_gaussian.hpp"
 #include "emulated_unit.hpp"
 #include "line_noise.hpp"

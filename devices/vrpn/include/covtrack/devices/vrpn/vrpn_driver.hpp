@@ -11,7 +11,7 @@
 
 #include "covtrack/devices/config_reader.hpp"
 #include "covtrack/devices/driver.hpp"
-#include "covtrack/devices/vrpn/tracker_address.hpp"
+#include "covtrack/vrpn/tracker_address.hpp"
 
 namespace covtrack::vrpn {
 

@@ -17,12 +17,12 @@
 
 #include "covtrack/devices/driver.hpp"
 #include "covtrack/devices/driver_clock.hpp"
-#include "covtrack/devices/lenz/lenz_config.hpp"
-#include "covtrack/devices/lenz/track_layout.hpp"
-#include "covtrack/devices/lenz/xpressnet_framing.hpp"
-#include "covtrack/devices/lenz/xpressnet_messages.hpp"
+#include "covtrack/devices/lenz/lenz_driver.hpp"
 #include "covtrack/devices/serial/pseudo_terminal.hpp"
 #include "covtrack/emulators/lenz/train_motion.hpp"
+#include "track_layout.hpp"
+#include "xpressnet_framing.hpp"
+#include "xpressnet_messages.hpp"
 
 namespace covtrack::lenz {
 

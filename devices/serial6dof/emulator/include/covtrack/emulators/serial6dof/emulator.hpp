@@ -2,7 +2,7 @@
 // An emulated serial 6-DOF tracker (FASTRAK / IS-900, LIBERTY / PATRIOT, Flock of Birds)
 // behind a pseudo-terminal: it answers status, who-am-I and examine requests, honours
 // the unit and output-list commands, takes its reset time, and streams records at the
-// device's rate with noise drawn from the model's covariance (covariance_model.hpp),
+// device's rate with noise drawn from the model's covariance (src/covariance_model.hpp),
 // reporting each noise-free pose as truth.
 #include <atomic>
 #include <functional>
@@ -13,7 +13,7 @@
 
 #include "covtrack/devices/driver.hpp"
 #include "covtrack/devices/driver_clock.hpp"
-#include "covtrack/devices/serial6dof/device_model.hpp"
+#include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 
 namespace covtrack::emulate6dof {
 

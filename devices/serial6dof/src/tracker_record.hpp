@@ -6,6 +6,7 @@
 #include <string>
 #include <variant>
 
+#include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 #include "covtrack/protocol/se3.hpp"
 
 namespace covtrack::serial6dof {
@@ -30,7 +31,6 @@ struct DeviceReply {
 
 using DecodedItem = std::variant<TrackerRecord, DeviceReply>;
 
-enum class Units { Inches, Centimetres };
 inline double metres_per_unit(Units u) { return u == Units::Inches ? 0.0254 : 0.01; }
 
 }  // namespace covtrack::serial6dof

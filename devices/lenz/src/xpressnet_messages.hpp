@@ -7,7 +7,7 @@
 #include <variant>
 #include <vector>
 
-#include "covtrack/devices/lenz/xpressnet_framing.hpp"
+#include "xpressnet_framing.hpp"
 
 namespace covtrack::lenz {
 

@@ -22,13 +22,10 @@
 #include <optional>
 #include <vector>
 
-#include "covtrack/devices/lenz/track_layout.hpp"
+#include "covtrack/devices/lenz/lenz_driver.hpp"
+#include "track_layout.hpp"
 
 namespace covtrack::lenz {
-
-struct DeadReckoningParams {
-  double crossing_latency_s = 0.05;  // a crossing is detected at most this late
-};
 
 struct AlongTrack {
   enum class State { Lost, WholeSection, DeadReckoning } state = State::Lost;

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "covtrack/devices/serial6dof/resync_buffer.hpp"
-#include "covtrack/devices/serial6dof/tracker_record.hpp"
+#include "resync_buffer.hpp"
+#include "tracker_record.hpp"
 
 namespace covtrack::serial6dof {
 

@@ -5,9 +5,9 @@
 // their noise from this same function, so NEES tests check it end to end.
 #include <optional>
 
-#include "covtrack/devices/serial6dof/device_model.hpp"
-#include "covtrack/devices/serial6dof/tracker_record.hpp"
 #include "covtrack/protocol/pose_message.hpp"
+#include "device_model.hpp"
+#include "tracker_record.hpp"
 
 namespace covtrack::serial6dof {
 

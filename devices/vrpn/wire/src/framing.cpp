@@ -1,10 +1,10 @@
-#include "covtrack/devices/vrpn/framing.hpp"
+#include "covtrack/vrpn/framing.hpp"
 
 #include <algorithm>
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/vrpn/byte_order.hpp"
+#include "covtrack/vrpn/byte_order.hpp"
 
 namespace covtrack::vrpn {
 namespace {

@@ -5,8 +5,9 @@
 #include <vector>
 
 #include "covtrack/devices/config_reader.hpp"
-#include "covtrack/devices/lenz/track_layout.hpp"
+#include "covtrack/devices/lenz/lenz_driver.hpp"
 #include "covtrack/protocol/result.hpp"
+#include "track_layout.hpp"
 
 namespace covtrack::lenz {
 
@@ -15,7 +16,6 @@ const TableSpec& layout_train_spec();
 const TableSpec& layout_vehicle_spec();
 const TableSpec& layout_section_spec();
 const TableSpec& layout_segment_spec();
-std::vector<const TableSpec*> layout_specs();
 
 // Every problem as "file:line:column: key: what", all at once.
 Result<TrackLayout> load_layout(const std::string& path);

@@ -11,16 +11,10 @@
 #include <vector>
 
 #include "covtrack/devices/driver.hpp"
-#include "covtrack/devices/lenz/dead_reckoning.hpp"
-#include "covtrack/devices/lenz/track_layout.hpp"
+#include "dead_reckoning.hpp"
+#include "track_layout.hpp"
 
 namespace covtrack::lenz {
-
-struct PoseModelParams {
-  double track_sigma_m = 0.003;    // where the rails really are, per axis
-  double track_sigma_rad = 0.01;   // how the vehicle really sits on them, per axis
-  double min_sigma_s_m = 0.001;    // along-track floor when the interval closes up
-};
 
 // Along-track standard deviation whose 99% interval is [lo, hi].
 double along_track_sigma(const AlongTrack& a, const PoseModelParams& params);

@@ -1,4 +1,4 @@
-#include "covtrack/devices/vrpn/cookie.hpp"
+#include "covtrack/vrpn/cookie.hpp"
 
 #include <algorithm>
 

@@ -1,12 +1,12 @@
-#include "covtrack/devices/vrpn/tracker_address.hpp"
+#include "covtrack/vrpn/tracker_address.hpp"
 
 #include <algorithm>
 #include <charconv>
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/vrpn/message_names.hpp"
-#include "covtrack/devices/vrpn/system_messages.hpp"
+#include "covtrack/vrpn/message_names.hpp"
+#include "covtrack/vrpn/system_messages.hpp"
 
 namespace covtrack::vrpn {
 namespace {

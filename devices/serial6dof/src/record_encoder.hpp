@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "covtrack/devices/serial6dof/fastrak_decoder.hpp"
-#include "covtrack/devices/serial6dof/flock_decoder.hpp"
-#include "covtrack/devices/serial6dof/liberty_decoder.hpp"
+#include "fastrak_decoder.hpp"
+#include "flock_decoder.hpp"
+#include "liberty_decoder.hpp"
 
 namespace covtrack::serial6dof {
 

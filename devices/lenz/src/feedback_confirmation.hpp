@@ -14,9 +14,9 @@
 #include <utility>
 #include <vector>
 
-#include "covtrack/devices/lenz/dead_reckoning.hpp"
-#include "covtrack/devices/lenz/feedback_state.hpp"
-#include "covtrack/devices/lenz/xpressnet_messages.hpp"
+#include "dead_reckoning.hpp"
+#include "feedback_state.hpp"
+#include "xpressnet_messages.hpp"
 
 namespace covtrack::lenz {
 

@@ -8,13 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "covtrack/devices/serial6dof/resync_buffer.hpp"
-#include "covtrack/devices/serial6dof/tracker_record.hpp"
+#include "resync_buffer.hpp"
+#include "tracker_record.hpp"
 
 namespace covtrack::serial6dof {
-
-// Output-list items after position (2) and quaternion (7) (PDI SDK).
-enum class LibertyExtra { Timestamp = 8, FrameCount = 9, Stylus = 10 };
 
 struct LibertyFormat {
   Units units = Units::Centimetres;

@@ -1,10 +1,10 @@
-#include "covtrack/devices/vrpn/system_messages.hpp"
+#include "covtrack/vrpn/system_messages.hpp"
 
 #include <algorithm>
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/vrpn/byte_order.hpp"
+#include "covtrack/vrpn/byte_order.hpp"
 
 namespace covtrack::vrpn {
 namespace {

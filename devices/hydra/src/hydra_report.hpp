@@ -11,13 +11,12 @@
 #include <span>
 #include <string>
 
+#include "covtrack/devices/hydra/hydra_driver.hpp"
 #include "covtrack/protocol/result.hpp"
 #include "covtrack/protocol/se3.hpp"
 
 namespace covtrack::hydra {
 
-inline constexpr std::uint16_t kVendorId = 0x1532;
-inline constexpr std::uint16_t kProductId = 0x0300;
 inline constexpr int kDataInterface = 0;
 inline constexpr std::size_t kReportSize = 52;
 inline constexpr std::size_t kControllerOffset[2] = {8, 30};

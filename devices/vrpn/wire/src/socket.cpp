@@ -1,4 +1,4 @@
-#include "covtrack/devices/vrpn/socket.hpp"
+#include "covtrack/vrpn/socket.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>

@@ -3,12 +3,10 @@
 // report rate and reset time. The defaults of the driver and of the emulator.
 #include <string_view>
 
+#include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 #include "covtrack/protocol/se3.hpp"
 
 namespace covtrack::serial6dof {
-
-enum class Protocol { Fastrak, Liberty, Flock };
-enum class Model { Fastrak, Is900, Liberty, Patriot, Flock };
 
 struct ModelSpec {
   Model model;

@@ -13,8 +13,8 @@
 
 #include "covtrack/devices/driver.hpp"
 #include "covtrack/devices/hydra/hydra_driver.hpp"
-#include "covtrack/devices/hydra/hydra_report.hpp"
 #include "covtrack/devices/motion_gate.hpp"
+#include "hydra_report.hpp"
 
 namespace covtrack::hydra {
 

@@ -13,9 +13,9 @@
 #include <string_view>
 #include <vector>
 
-#include "covtrack/devices/vrpn/cookie.hpp"
-#include "covtrack/devices/vrpn/framing.hpp"
 #include "covtrack/protocol/result.hpp"
+#include "covtrack/vrpn/cookie.hpp"
+#include "covtrack/vrpn/framing.hpp"
 
 namespace covtrack::vrpn {
 

@@ -1,11 +1,11 @@
-#include "covtrack/devices/vrpn/session.hpp"
+#include "covtrack/vrpn/session.hpp"
 
 #include <algorithm>
 #include <utility>
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/vrpn/system_messages.hpp"
+#include "covtrack/vrpn/system_messages.hpp"
 
 namespace covtrack::vrpn {
 namespace {

@@ -1,11 +1,11 @@
-#include "covtrack/devices/vrpn/tracker_report.hpp"
+#include "covtrack/vrpn/tracker_report.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/vrpn/byte_order.hpp"
+#include "covtrack/vrpn/byte_order.hpp"
 
 namespace covtrack::vrpn {
 

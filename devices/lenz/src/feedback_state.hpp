@@ -7,8 +7,8 @@
 #include <optional>
 #include <vector>
 
-#include "covtrack/devices/lenz/track_layout.hpp"
-#include "covtrack/devices/lenz/xpressnet_messages.hpp"
+#include "track_layout.hpp"
+#include "xpressnet_messages.hpp"
 
 namespace covtrack::lenz {
 

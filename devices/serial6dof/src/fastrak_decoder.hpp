@@ -7,15 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "covtrack/devices/serial6dof/resync_buffer.hpp"
-#include "covtrack/devices/serial6dof/tracker_record.hpp"
+#include "resync_buffer.hpp"
+#include "tracker_record.hpp"
 
 namespace covtrack::serial6dof {
-
-// Output-list items after position (2) and quaternion (11), in list order
-// (FASTRAK manual; IS-900 user guide). The driver always asks for 2, 11, then these,
-// then 1 (CR LF).
-enum class FastrakExtra { Timestamp = 21, Buttons = 22, Stylus = 16, Joystick = 23 };
 
 struct FastrakFormat {
   Units units = Units::Centimetres;
