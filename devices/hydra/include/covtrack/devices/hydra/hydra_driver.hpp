@@ -10,6 +10,7 @@
 
 #include "covtrack/devices/config_reader.hpp"
 #include "covtrack/devices/driver.hpp"
+#include "covtrack/devices/driver_clock.hpp"
 #include "covtrack/devices/motion_gate.hpp"
 
 namespace covtrack::hydra {
@@ -37,6 +38,7 @@ Mat6 hydra_default_covariance();
 const TableSpec& hydra_device_spec();
 HydraConfig read_hydra_config(TableReader& device, const std::string& device_name);
 
-std::unique_ptr<Driver> make_hydra_driver(const HydraConfig& config);
+// Every timeout, mode-switch retry and time stamp of the driver is on `clock`.
+std::unique_ptr<Driver> make_hydra_driver(const HydraConfig& config, DriverClock& clock = real_clock());
 
 }  // namespace covtrack::hydra
