@@ -29,6 +29,9 @@ class EmulatedUnit {
   virtual int trouble_code() const = 0;
 };
 
+// Appends `bytes` to `out`.
+inline void append(Bytes& out, const Bytes& bytes) { out.insert(out.end(), bytes.begin(), bytes.end()); }
+
 std::unique_ptr<EmulatedUnit> make_fastrak_unit(const EmulatorConfig& config);
 std::unique_ptr<EmulatedUnit> make_liberty_unit(const EmulatorConfig& config);
 std::unique_ptr<EmulatedUnit> make_flock_unit(const EmulatorConfig& config);

@@ -1,26 +1,24 @@
 // An emulated FASTRAK / IS-900 (Polhemus FASTRAK manual). Powers up polled, ASCII, inches,
 // output list 2,4,1 (Euler: not emulated, so it sends no records until asked for 2,11).
 #include <algorithm>
-#include <map>
+#include <cstdlib>
 #include <string>
 
-#include "emulated_unit.hpp"
+#include "polhemus_unit.hpp"
 
 namespace covtrack::emulate6dof {
 namespace {
 
 using namespace serial6dof;
 
-class FastrakUnit final : public EmulatedUnit {
+struct FastrakList {
+  std::vector<FastrakExtra> extras;
+  bool crlf = true;
+};
+
+class FastrakUnit final : public PolhemusUnit<FastrakList> {
  public:
   explicit FastrakUnit(const EmulatorConfig& config) : config_(config) { power_on(); }
-
-  void power_on() override {
-    units_ = Units::Inches;
-    binary_ = false;
-    continuous_ = false;
-    lists_.clear();
-  }
 
   bool handle(std::vector<std::uint8_t>& in, Bytes& reply) override {
     while (!in.empty()) {
@@ -41,56 +39,31 @@ class FastrakUnit final : public EmulatedUnit {
         case 'F': binary_ = false; break;
         case 'u': units_ = Units::Centimetres; break;
         case 'U': units_ = Units::Inches; break;
-        case 'S': {
-          const Bytes s = encode_fastrak_status(config_.stations.front().number, units_);
-          reply.insert(reply.end(), s.begin(), s.end());
-          break;
-        }
+        case 'S': append(reply, encode_fastrak_status(config_.stations.front().number, units_)); break;
         default: break;  // CR, LF and unknown commands are ignored, as a unit does
       }
     }
     return false;
   }
 
-  bool streaming() const override { return continuous_; }
-
-  Bytes encode(const std::vector<TrackerRecord>& records) const override {
-    Bytes out;
-    if (!binary_) return out;  // ASCII records are not emulated
-    for (const auto& r : records) {
-      auto it = lists_.find(r.station);
-      if (it == lists_.end()) continue;  // still the default list: not emulated
-      const Bytes b = encode_fastrak_record(r, {units_, it->second.extras, it->second.crlf});
-      out.insert(out.end(), b.begin(), b.end());
-    }
-    return out;
-  }
-
   int trouble_code() const override { return 'B'; }  // a weak-signal letter
 
  private:
-  struct OutputList {
-    std::vector<FastrakExtra> extras;
-    bool crlf = true;
-  };
+  Bytes encode_record(const TrackerRecord& r, const FastrakList& list) const override {
+    return encode_fastrak_record(r, {units_, list.extras, list.crlf});
+  }
 
   // Accepts lists of the form 2,11[,extras...],0|1; anything else leaves the station
   // on a list this emulator does not produce.
   void set_output_list(const std::string& args) {
     std::vector<int> items;
-    int station = 0;
-    std::size_t at = 0;
-    for (bool first = true; at <= args.size(); first = false) {
-      const auto comma = std::min(args.find(',', at), args.size());
-      const int v = std::atoi(args.substr(at, comma - at).c_str());
-      if (first) station = v;
-      else items.push_back(v);
-      at = comma + 1;
-    }
+    for (const auto& field : comma_fields(args)) items.push_back(std::atoi(field.c_str()));
+    const int station = items.front();
+    items.erase(items.begin());
     lists_.erase(station);
     if (items.size() < 3 || items[0] != 2 || items[1] != 11) return;
     if (items.back() != 0 && items.back() != 1) return;
-    OutputList list;
+    FastrakList list;
     list.crlf = items.back() == 1;
     for (std::size_t i = 2; i + 1 < items.size(); ++i) {
       if (items[i] != 21 && items[i] != 22 && items[i] != 16 && items[i] != 23) return;
@@ -100,9 +73,6 @@ class FastrakUnit final : public EmulatedUnit {
   }
 
   EmulatorConfig config_;
-  Units units_ = Units::Inches;
-  bool binary_ = false, continuous_ = false;
-  std::map<int, OutputList> lists_;
 };
 
 }  // namespace

@@ -67,8 +67,7 @@ class FlockUnit final : public EmulatedUnit {
     for (const auto& r : records) {
       if (!position_quaternion_.count(r.station)) continue;  // other formats not emulated
       if (!group_mode_ && r.station != config_.stations.front().number) continue;
-      const Bytes b = encode_flock_record(r, f);
-      out.insert(out.end(), b.begin(), b.end());
+      append(out, encode_flock_record(r, f));
     }
     return out;
   }

@@ -2,28 +2,21 @@
 // polled, ASCII, inches. Commands end with CR, except P (single record, also ends
 // continuous output).
 #include <algorithm>
-#include <map>
+#include <cstdlib>
 #include <string>
 
-#include "emulated_unit.hpp"
+#include "polhemus_unit.hpp"
 
 namespace covtrack::emulate6dof {
 namespace {
 
 using namespace serial6dof;
 
-class LibertyUnit final : public EmulatedUnit {
+class LibertyUnit final : public PolhemusUnit<std::vector<LibertyExtra>> {
  public:
   explicit LibertyUnit(const EmulatorConfig& config)
       : config_(config), preamble_(config.model == Model::Patriot ? "PA" : "LY") {
     power_on();
-  }
-
-  void power_on() override {
-    units_ = Units::Inches;
-    binary_ = false;
-    continuous_ = false;
-    lists_.clear();
   }
 
   bool handle(std::vector<std::uint8_t>& in, Bytes& reply) override {
@@ -51,23 +44,12 @@ class LibertyUnit final : public EmulatedUnit {
     return false;
   }
 
-  bool streaming() const override { return continuous_; }
-
-  Bytes encode(const std::vector<TrackerRecord>& records) const override {
-    Bytes out;
-    if (!binary_) return out;  // ASCII records are not emulated
-    for (const auto& r : records) {
-      auto it = lists_.find(r.station);
-      if (it == lists_.end()) continue;
-      const Bytes b = encode_liberty_record(r, {units_, it->second}, preamble_);
-      out.insert(out.end(), b.begin(), b.end());
-    }
-    return out;
-  }
-
   int trouble_code() const override { return 0x05; }  // a non-zero PDI error code
 
  private:
+  Bytes encode_record(const TrackerRecord& r, const std::vector<LibertyExtra>& extras) const override {
+    return encode_liberty_record(r, {units_, extras}, preamble_);
+  }
   static Bytes setting(std::uint32_t v) {
     return {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8),
             static_cast<std::uint8_t>(v >> 16), static_cast<std::uint8_t>(v >> 24)};
@@ -78,18 +60,11 @@ class LibertyUnit final : public EmulatedUnit {
     return Bytes(text.begin(), text.end());
   }
   void answer(char command, const Bytes& payload, Bytes& reply) const {
-    const Bytes b = binary_ ? encode_liberty_frame(1, command, 0, payload, preamble_) : payload;
-    reply.insert(reply.end(), b.begin(), b.end());
+    append(reply, binary_ ? encode_liberty_frame(1, command, 0, payload, preamble_) : payload);
   }
   // Accepts O<st>,2,7[,8|9|10...],1; "*" means every station.
   void set_output_list(const std::string& args) {
-    std::vector<std::string> parts;
-    std::size_t at = 0;
-    while (at <= args.size()) {
-      const auto comma = std::min(args.find(',', at), args.size());
-      parts.push_back(args.substr(at, comma - at));
-      at = comma + 1;
-    }
+    const std::vector<std::string> parts = comma_fields(args);
     std::vector<int> stations;
     if (parts[0] == "*") for (const auto& s : config_.stations) stations.push_back(s.number);
     else stations.push_back(std::atoi(parts[0].c_str()));
@@ -106,9 +81,6 @@ class LibertyUnit final : public EmulatedUnit {
 
   EmulatorConfig config_;
   const char* preamble_;
-  Units units_ = Units::Inches;
-  bool binary_ = false, continuous_ = false;
-  std::map<int, std::vector<LibertyExtra>> lists_;
 };
 
 }  // namespace
