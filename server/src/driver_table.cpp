@@ -2,7 +2,6 @@
 
 #include "covtrack/devices/fiducial/fiducial_driver.hpp"
 #include "covtrack/devices/hydra/hydra_driver.hpp"
-#include "covtrack/devices/lenz/layout_config.hpp"
 #include "covtrack/devices/lenz/lenz_driver.hpp"
 #include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 #include "covtrack/devices/sim/sim_driver.hpp"

@@ -12,7 +12,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "covtrack/devices/vrpn/message_names.hpp"
+#include "covtrack/vrpn/message_names.hpp"
 
 namespace covtrack::server {
 namespace {

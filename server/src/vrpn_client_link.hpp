@@ -9,10 +9,10 @@
 #include <string_view>
 #include <vector>
 
-#include "covtrack/devices/vrpn/session.hpp"
-#include "covtrack/devices/vrpn/socket.hpp"
-#include "covtrack/devices/vrpn/tracker_report.hpp"
 #include "covtrack/protocol/result.hpp"
+#include "covtrack/vrpn/session.hpp"
+#include "covtrack/vrpn/socket.hpp"
+#include "covtrack/vrpn/tracker_report.hpp"
 
 namespace covtrack::server {
 

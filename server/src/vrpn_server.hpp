@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "covtrack/devices/driver.hpp"
-#include "covtrack/devices/vrpn/socket.hpp"
-#include "covtrack/devices/vrpn/tracker_report.hpp"
 #include "covtrack/protocol/result.hpp"
+#include "covtrack/vrpn/socket.hpp"
+#include "covtrack/vrpn/tracker_report.hpp"
 #include "vrpn_client_link.hpp"
 #include "vrpn_server_config.hpp"
 

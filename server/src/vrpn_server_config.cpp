@@ -8,9 +8,9 @@
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/vrpn/message_names.hpp"
-#include "covtrack/devices/vrpn/system_messages.hpp"
 #include "covtrack/protocol/channels.hpp"
+#include "covtrack/vrpn/message_names.hpp"
+#include "covtrack/vrpn/system_messages.hpp"
 
 namespace covtrack::server {
 namespace {

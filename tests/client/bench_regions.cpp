@@ -1,7 +1,9 @@
 // One frame = 1,000 objects x 8 hull vertices: projection + outer + inner + assessment.
 // Unscented (default) vs the linear fast path vs a 1,000-sample Monte Carlo of the same
 // frame. Single thread. Run: build/tests/client/bench_regions
+#include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <map>
 #include <random>
 #include <string>
@@ -48,6 +50,30 @@ void BM_FrameLinear(benchmark::State& state) { run_frame(state, ProjectionMethod
 void BM_FrameUnscentedPerVertexScale(benchmark::State& state) {
   run_frame(state, ProjectionMethod::unscented, false);
 }
+
+// The frame with every object's rotation error 8 degrees on each axis (the frame's are 1-5):
+// the fifth-degree cubature (the default there) against the unscented transform.
+void strong_rotation_frame(benchmark::State& state, double cubature_min_rotation_trace_rad2) {
+  static const Frame f = [] {
+    Frame rotated = frame();
+    for (auto& pose : rotated.poses) {
+      pose.covariance.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * std::pow(8 * std::numbers::pi / 180, 2);
+      pose.covariance.topRightCorner<3, 3>().setZero();
+      pose.covariance.bottomLeftCorner<3, 3>().setZero();
+    }
+    return rotated;
+  }();
+  ObjectRegionOptions o;
+  o.projection.unscented.cubature_min_rotation_trace_rad2 = cubature_min_rotation_trace_rad2;
+  std::vector<ObjectRegions> regions(f.poses.size());
+  for (auto _ : state)
+    for (std::size_t i = 0; i < f.poses.size(); ++i) {
+      compute_object_regions(f.camera, f.poses[i], f.vertices[i], o, regions[i]);
+      benchmark::DoNotOptimize(regions[i].assessment);
+    }
+}
+void BM_FrameEightDegreesCubature(benchmark::State& state) { strong_rotation_frame(state, kCubatureMinRotationTraceRad2); }
+void BM_FrameEightDegreesUnscented(benchmark::State& state) { strong_rotation_frame(state, INFINITY); }
 
 // The same regions from sample covariances of 1,000 sampled poses per object.
 void BM_FrameMonteCarlo1000(benchmark::State& state) {
@@ -157,6 +183,8 @@ BENCHMARK(BM_FrameUnscentedPerVertexScale)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameProjectionOnlyUnscented)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameOuterOnly)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameInnerOnly)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameEightDegreesCubature)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameEightDegreesUnscented)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameMonteCarlo1000)->Unit(benchmark::kMillisecond);
 // The figures are ratios within one run (the machine's speed cancels): after the
 // usual table, the CPU time of each frame against the unscented frame.

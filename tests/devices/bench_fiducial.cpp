@@ -13,7 +13,7 @@
 #include "covtrack/devices/fiducial/corner_noise.hpp"
 #include "covtrack/devices/fiducial/lens_edge_bend.hpp"
 #include "covtrack/devices/fiducial/tag_detector.hpp"
-#include "covtrack/devices/fiducial/tag_image_formation.hpp"
+#include "covtrack/emulators/fiducial/tag_image_formation.hpp"
 #include "covtrack/devices/fiducial/tag_pose.hpp"
 #include "fiducial_scene.hpp"
 

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <random>
 
-#include "covtrack/devices/fiducial/noise_calibration.hpp"
+#include "covtrack/emulators/fiducial/noise_calibration.hpp"
 #include "covtrack/devices/fiducial/tag_pose.hpp"
 #include "fiducial_scene.hpp"
 

@@ -20,7 +20,7 @@
 
 #include "covtrack/devices/fiducial/fiducial_driver.hpp"
 #include "covtrack/devices/fiducial/raw_detection.hpp"
-#include "covtrack/devices/fiducial/tag_renderer.hpp"
+#include "covtrack/emulators/fiducial/tag_renderer.hpp"
 #include "fiducial_scene.hpp"
 #include "manual_clock.hpp"
 

@@ -19,7 +19,7 @@
 #include "covtrack/devices/fiducial/board_calibration.hpp"
 #include "covtrack/devices/fiducial/corner_noise.hpp"
 #include "covtrack/devices/fiducial/tag_detector.hpp"
-#include "covtrack/devices/fiducial/tag_image_formation.hpp"
+#include "covtrack/emulators/fiducial/tag_image_formation.hpp"
 #include "fiducial_scene.hpp"
 
 using namespace covtrack;

@@ -7,7 +7,7 @@
 #include <cstdio>
 
 #include "covtrack/devices/fiducial/lens_edge_bend.hpp"
-#include "covtrack/devices/fiducial/noise_calibration.hpp"
+#include "covtrack/emulators/fiducial/noise_calibration.hpp"
 #include "fiducial_scene.hpp"
 
 using namespace covtrack;

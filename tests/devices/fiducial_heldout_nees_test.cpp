@@ -17,7 +17,7 @@
 #include <random>
 #include <string>
 
-#include "covtrack/devices/fiducial/noise_calibration.hpp"
+#include "covtrack/emulators/fiducial/noise_calibration.hpp"
 #include "fiducial_heldout_sets.hpp"
 
 using namespace covtrack;

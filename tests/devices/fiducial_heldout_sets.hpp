@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "covtrack/devices/fiducial/noise_calibration.hpp"
+#include "covtrack/emulators/fiducial/noise_calibration.hpp"
 #include "fiducial_scene.hpp"
 
 namespace covtrack::test {

@@ -6,8 +6,8 @@
 
 #include "covtrack/devices/fiducial/corner_noise.hpp"
 #include "covtrack/devices/fiducial/tag_detector.hpp"
-#include "covtrack/devices/fiducial/tag_image_formation.hpp"
-#include "covtrack/devices/fiducial/tag_renderer.hpp"
+#include "covtrack/emulators/fiducial/tag_image_formation.hpp"
+#include "covtrack/emulators/fiducial/tag_renderer.hpp"
 #include "fiducial_scene.hpp"
 
 using namespace covtrack;

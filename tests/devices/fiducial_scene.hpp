@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "covtrack/devices/fiducial/tag_image_formation.hpp"
+#include "covtrack/emulators/fiducial/tag_image_formation.hpp"
 #include "covtrack/protocol/camera_opencv.hpp"
 #include "covtrack/protocol/se3.hpp"
 

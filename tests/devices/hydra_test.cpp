@@ -9,8 +9,8 @@
 
 #include "capture_sink.hpp"
 #include "covtrack/devices/hydra/hydra_driver.hpp"
-#include "covtrack/devices/hydra/hydra_report.hpp"
-#include "covtrack/devices/hydra/hydra_stream.hpp"
+#include "hydra_report.hpp"
+#include "hydra_stream.hpp"
 
 using namespace covtrack;
 using namespace covtrack::hydra;

@@ -5,9 +5,9 @@
 #include <variant>
 #include <vector>
 
-#include "covtrack/devices/lenz/feedback_state.hpp"
-#include "covtrack/devices/lenz/xpressnet_framing.hpp"
-#include "covtrack/devices/lenz/xpressnet_messages.hpp"
+#include "feedback_state.hpp"
+#include "xpressnet_framing.hpp"
+#include "xpressnet_messages.hpp"
 
 using namespace covtrack::lenz;
 using Bytes = std::vector<std::uint8_t>;

@@ -21,10 +21,11 @@
 #include <Eigen/Cholesky>
 
 #include "capture_sink.hpp"
-#include "covtrack/devices/lenz/layout_config.hpp"
 #include "covtrack/devices/lenz/lenz_driver.hpp"
 #include "covtrack/devices/serial/pseudo_terminal.hpp"
 #include "covtrack/emulators/lenz/lenz_emulator.hpp"
+#include "dead_reckoning.hpp"
+#include "layout_config.hpp"
 #include "manual_clock.hpp"
 
 using namespace covtrack;

@@ -14,12 +14,12 @@
 #include <Eigen/Cholesky>
 
 #include "capture_sink.hpp"
-#include "covtrack/devices/lenz/dead_reckoning.hpp"
-#include "covtrack/devices/lenz/feedback_confirmation.hpp"
-#include "covtrack/devices/lenz/layout_config.hpp"
-#include "covtrack/devices/lenz/lenz_config.hpp"
-#include "covtrack/devices/lenz/train_poses.hpp"
+#include "covtrack/devices/lenz/lenz_driver.hpp"
 #include "covtrack/emulators/lenz/train_motion.hpp"
+#include "dead_reckoning.hpp"
+#include "feedback_confirmation.hpp"
+#include "layout_config.hpp"
+#include "train_poses.hpp"
 
 using namespace covtrack;
 using namespace covtrack::lenz;

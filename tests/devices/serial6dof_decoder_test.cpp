@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "covtrack/devices/serial6dof/record_encoder.hpp"
+#include "record_encoder.hpp"
 #include "serial6dof_stream.hpp"
 
 using namespace covtrack;

@@ -17,7 +17,8 @@
 
 #include "capture_sink.hpp"
 #include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
-#include "covtrack/emulate6dof/emulator.hpp"
+#include "covtrack/emulators/serial6dof/emulator.hpp"
+#include "device_model.hpp"
 #include "manual_clock.hpp"
 
 using namespace covtrack;

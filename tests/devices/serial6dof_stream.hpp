@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <iterator>
 
-#include "covtrack/devices/serial6dof/record_encoder.hpp"
+#include "record_encoder.hpp"
 
 namespace covtrack::serial6dof::test {
 

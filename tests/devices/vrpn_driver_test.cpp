@@ -2,48 +2,71 @@
 // the configured covariance; a report of an unlisted sensor, of the wrong size or with a
 // time stamp far from this host's clock is counted; a dropped connection makes every
 // reporting sensor LOST; a server that is no VRPN server, or serves no device of the
-// configured name, fails the driver with an error saying so.
+// configured name, fails the driver with an error saying so. Driver and server run on
+// simulated time (manual_clock.hpp): the timeouts pass in steps, not in wall time.
 #include <gtest/gtest.h>
 
 #include <poll.h>
 #include <sys/socket.h>
 
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <thread>
 
 #include "capture_sink.hpp"
-#include "covtrack/devices/vrpn/message_names.hpp"
-#include "covtrack/devices/vrpn/session.hpp"
-#include "covtrack/devices/vrpn/socket.hpp"
-#include "covtrack/devices/vrpn/tracker_report.hpp"
 #include "covtrack/devices/vrpn/vrpn_driver.hpp"
-#include "covtrack/protocol/clock.hpp"
+#include "covtrack/vrpn/message_names.hpp"
+#include "covtrack/vrpn/session.hpp"
+#include "covtrack/vrpn/socket.hpp"
+#include "covtrack/vrpn/tracker_report.hpp"
+#include "manual_clock.hpp"
 
 using namespace covtrack;
 using namespace covtrack::vrpn;
 
 namespace {
 
-// Accepts one connection on a loopback port and runs `script` on it, on its own thread.
+// The scripted server's end of a connection. The server moves in step with the driver on
+// the test's clock: each of its waits is one step, so that simulated time passes only while
+// both sides wait, however slowly either of them runs.
+struct Peer {
+  const Socket& socket;
+  test::ManualClock& clock;
+  std::stop_token stop;
+
+  // Waits for the clock's next step, then says whether there is something to read (or
+  // the end of the connection).
+  bool readable_next_step() const { return readable_next_step(socket.fd(), clock, stop); }
+  static bool readable_next_step(int fd, test::ManualClock& clock, std::stop_token stop) {
+    clock.sleep_until(stop, clock.now() + std::chrono::nanoseconds(1));
+    pollfd p{fd, POLLIN, 0};
+    return ::poll(&p, 1, 0) > 0;
+  }
+};
+
+// Accepts one connection on a loopback port and runs `script` on it, on its own thread,
+// in step with `clock`.
 class ScriptedServer {
  public:
-  explicit ScriptedServer(std::function<void(const Socket&)> script) {
+  ScriptedServer(test::ManualClock& clock, std::function<void(const Peer&)> script) {
     auto listener = listen_tcp("127.0.0.1", 0);
     EXPECT_TRUE(listener);
     sockaddr_in a{};
     socklen_t size = sizeof a;
     getsockname(listener->fd(), reinterpret_cast<sockaddr*>(&a), &size);
     port = ntohs(a.sin_port);
-    thread_ = std::jthread([l = std::move(*listener), script](std::stop_token stop) {
-      pollfd p{l.fd(), POLLIN, 0};
+    clock.join();
+    thread_ = std::jthread([l = std::move(*listener), &clock, script](std::stop_token stop) {
       while (!stop.stop_requested())
-        if (::poll(&p, 1, 20) > 0) {
+        if (Peer::readable_next_step(l.fd(), clock, stop)) {
           Socket s(::accept(l.fd(), nullptr, nullptr));
-          script(s);
-          return;
+          script(Peer{s, clock, stop});
+          break;
         }
+      clock.leave();
     });
   }
   int port = 0;
@@ -52,29 +75,32 @@ class ScriptedServer {
   std::jthread thread_;
 };
 
-// Reads from `s` into `session` until it has the peer's cookie (or 5 s pass).
-void handshake(const Socket& s, Session& session) {
-  send_all(s, session.take_output(), 2);
+// Reads from the peer into `session` until it has the peer's cookie (or 250 steps pass).
+void handshake(const Peer& peer, Session& session) {
+  send_all(peer.socket, session.take_output(), 2);
   std::array<std::uint8_t, 4096> buffer{};
-  pollfd p{s.fd(), POLLIN, 0};
   for (int i = 0; i < 250 && !session.ready(); ++i)
-    if (::poll(&p, 1, 20) > 0) {
-      const ssize_t n = ::recv(s.fd(), buffer.data(), buffer.size(), 0);
+    if (peer.readable_next_step()) {
+      const ssize_t n = ::recv(peer.socket.fd(), buffer.data(), buffer.size(), 0);
       if (n <= 0) return;
-      (void)session.receive(std::span(buffer.data(), static_cast<std::size_t>(n)), now_us());
+      (void)session.receive(std::span(buffer.data(), static_cast<std::size_t>(n)), peer.clock.now_us());
     }
-  send_all(s, session.take_output(), 2);
+  send_all(peer.socket, session.take_output(), 2);
 }
 
-// Closes `s` in order: a FIN, then what the peer still sends (its pings) is read until it
-// closes too (or 5 s pass). A socket closed with unread bytes sends a reset instead, which
-// the driver reports as a broken connection, not a closed one.
-void close_in_order(const Socket& s) {
-  ::shutdown(s.fd(), SHUT_WR);
+// Reads what the peer sends (the driver's pings) until it closes the connection.
+void read_until_closed(const Peer& peer) {
   std::array<std::uint8_t, 4096> buffer{};
-  pollfd p{s.fd(), POLLIN, 0};
-  for (int i = 0; i < 250; ++i)
-    if (::poll(&p, 1, 20) > 0 && ::recv(s.fd(), buffer.data(), buffer.size(), 0) <= 0) return;
+  while (!peer.stop.stop_requested())
+    if (peer.readable_next_step() && ::recv(peer.socket.fd(), buffer.data(), buffer.size(), 0) <= 0) return;
+}
+
+// Closes the connection in order: a FIN, then what the peer still sends is read until it
+// closes too. A socket closed with unread bytes sends a reset instead, which the driver
+// reports as a broken connection, not a closed one.
+void close_in_order(const Peer& peer) {
+  ::shutdown(peer.socket.fd(), SHUT_WR);
+  read_until_closed(peer);
 }
 
 Mat6 diagonal(double position_sigma, double rotation_sigma) {
@@ -94,18 +120,31 @@ VrpnConfig config_for(int port, const std::string& name = "Tracker0") {
   return c;
 }
 
-Result<void> run_driver(const VrpnConfig& config, test::CaptureSink& sink) {
-  std::stop_source stop;
-  return make_vrpn_driver(config)->run(sink, stop.get_token());
+// Runs the driver on `clock` until it returns (within 10 s of simulated time).
+Result<void> run_driver(const VrpnConfig& config, test::CaptureSink& sink, test::ManualClock& clock) {
+  auto driver = make_vrpn_driver(config, clock);
+  std::atomic<bool> returned = false;
+  Result<void> result;
+  clock.join();
+  std::jthread t([&](std::stop_token stop) {
+    result = driver->run(sink, stop);
+    returned = true;
+    clock.leave();
+  });
+  EXPECT_TRUE(clock.run_until([&] { return returned.load(); }, std::chrono::seconds(10)));
+  t.request_stop();
+  t.join();
+  return result;
 }
 
 }  // namespace
 
 TEST(VrpnDriver, ReportsBecomePosesOddOnesAreCountedAndADropIsLost) {
-  const std::int64_t t0 = now_us();
-  ScriptedServer server([&](const Socket& s) {
+  test::ManualClock clock;
+  const std::int64_t t0 = clock.now_us();
+  ScriptedServer server(clock, [&](const Peer& peer) {
     Session session({"Tracker0"}, {std::string(kTrackerPosQuat)});
-    handshake(s, session);
+    handshake(peer, session);
     const Pose T = pose_from(Vec3(0.1, -0.2, 1.5), Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vec3(0, 0, 1))));
     session.send("Tracker0", kTrackerPosQuat, t0, encode_pos_quat(report_of(0, T)));
     session.send("Tracker0", kTrackerPosQuat, t0, encode_pos_quat(report_of(5, T)));  // not listed
@@ -113,11 +152,11 @@ TEST(VrpnDriver, ReportsBecomePosesOddOnesAreCountedAndADropIsLost) {
     short_report.resize(60);
     session.send("Tracker0", kTrackerPosQuat, t0, short_report);
     session.send("Tracker0", kTrackerPosQuat, t0 - 10'000'000, encode_pos_quat(report_of(0, T)));  // clock 10 s off
-    send_all(s, session.take_output(), 2);
-    close_in_order(s);  // then the server goes away
+    send_all(peer.socket, session.take_output(), 2);
+    close_in_order(peer);  // then the server goes away
   });
   test::CaptureSink sink;
-  const auto result = run_driver(config_for(server.port), sink);
+  const auto result = run_driver(config_for(server.port), sink, clock);
   ASSERT_FALSE(result);
   EXPECT_NE(result.error().message.find("closed the connection"), std::string::npos) << result.error().message;
   EXPECT_NE(result.error().message.find("sensors reported LOST"), std::string::npos);
@@ -137,16 +176,14 @@ TEST(VrpnDriver, ReportsBecomePosesOddOnesAreCountedAndADropIsLost) {
 }
 
 TEST(VrpnDriver, AServerWithoutTheNamedDeviceSaysNamesAreCaseSensitive) {
-  ScriptedServer server([](const Socket& s) {
+  test::ManualClock clock;
+  ScriptedServer server(clock, [](const Peer& peer) {
     Session session({"tracker0"}, {std::string(kTrackerPosQuat)});
-    handshake(s, session);
-    std::array<std::uint8_t, 4096> buffer{};
-    pollfd p{s.fd(), POLLIN, 0};
-    while (::poll(&p, 1, 2000) > 0 && ::recv(s.fd(), buffer.data(), buffer.size(), 0) > 0) {
-    }  // reads the pings for "Tracker0" and answers none, until the driver leaves
+    handshake(peer, session);
+    read_until_closed(peer);  // the pings for "Tracker0", answering none
   });
   test::CaptureSink sink;
-  const auto result = run_driver(config_for(server.port), sink);
+  const auto result = run_driver(config_for(server.port), sink, clock);
   ASSERT_FALSE(result);
   EXPECT_NE(result.error().message.find("no device named 'Tracker0' answers"), std::string::npos)
       << result.error().message;
@@ -155,16 +192,14 @@ TEST(VrpnDriver, AServerWithoutTheNamedDeviceSaysNamesAreCaseSensitive) {
 }
 
 TEST(VrpnDriver, APeerThatIsNoVrpnServerIsNamedAsSuch) {
-  ScriptedServer server([](const Socket& s) {
+  test::ManualClock clock;
+  ScriptedServer server(clock, [](const Peer& peer) {
     const std::string banner = "SSH-2.0-OpenSSH_9.2p1 Debian-2\r\n";
-    send_all(s, std::span(reinterpret_cast<const std::uint8_t*>(banner.data()), banner.size()), 2);
-    std::array<std::uint8_t, 64> buffer{};
-    pollfd p{s.fd(), POLLIN, 0};
-    while (::poll(&p, 1, 2000) > 0 && ::recv(s.fd(), buffer.data(), buffer.size(), 0) > 0) {
-    }
+    send_all(peer.socket, std::span(reinterpret_cast<const std::uint8_t*>(banner.data()), banner.size()), 2);
+    read_until_closed(peer);
   });
   test::CaptureSink sink;
-  const auto result = run_driver(config_for(server.port), sink);
+  const auto result = run_driver(config_for(server.port), sink, clock);
   ASSERT_FALSE(result);
   EXPECT_NE(result.error().message.find("not a VRPN peer of major version 07: it sent 'SSH-2.0-OpenSSH"),
             std::string::npos)
@@ -172,13 +207,14 @@ TEST(VrpnDriver, APeerThatIsNoVrpnServerIsNamedAsSuch) {
 }
 
 TEST(VrpnDriver, NoServerListeningIsAClearError) {
+  test::ManualClock clock;
   int port = 0;
   {
-    ScriptedServer closed([](const Socket&) {});
+    ScriptedServer closed(clock, [](const Peer&) {});
     port = closed.port;
   }  // nothing listens there any more
   test::CaptureSink sink;
-  const auto result = run_driver(config_for(port), sink);
+  const auto result = run_driver(config_for(port), sink, clock);
   ASSERT_FALSE(result);
   EXPECT_NE(result.error().message.find("is a vrpn_server running there?"), std::string::npos)
       << result.error().message;

@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
-#include "covtrack/devices/vrpn/cookie.hpp"
-#include "covtrack/devices/vrpn/framing.hpp"
-#include "covtrack/devices/vrpn/message_names.hpp"
-#include "covtrack/devices/vrpn/session.hpp"
-#include "covtrack/devices/vrpn/system_messages.hpp"
-#include "covtrack/devices/vrpn/tracker_address.hpp"
-#include "covtrack/devices/vrpn/tracker_report.hpp"
+#include "covtrack/vrpn/cookie.hpp"
+#include "covtrack/vrpn/framing.hpp"
+#include "covtrack/vrpn/message_names.hpp"
+#include "covtrack/vrpn/session.hpp"
+#include "covtrack/vrpn/system_messages.hpp"
+#include "covtrack/vrpn/tracker_address.hpp"
+#include "covtrack/vrpn/tracker_report.hpp"
 
 using namespace covtrack;
 using namespace covtrack::vrpn;

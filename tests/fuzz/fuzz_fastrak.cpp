@@ -1,6 +1,6 @@
 // Polhemus FASTRAK / IS-900 binary records and status records: the first byte picks the
 // output format (units, extra items, terminator), the rest is the serial stream.
-#include "covtrack/devices/serial6dof/fastrak_decoder.hpp"
+#include "fastrak_decoder.hpp"
 #include "fuzz/serial6dof_checks.hpp"
 
 using namespace covtrack;

@@ -1,6 +1,6 @@
 // Ascension Flock of Birds POSITION/QUATERNION records: the first byte picks the full
 // scale and group mode, the rest is the serial stream.
-#include "covtrack/devices/serial6dof/flock_decoder.hpp"
+#include "flock_decoder.hpp"
 #include "fuzz/serial6dof_checks.hpp"
 
 using namespace covtrack;

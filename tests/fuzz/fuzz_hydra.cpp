@@ -1,9 +1,9 @@
 // Razer Hydra input reports: the input as a sequence of (time step, 52-byte report)
 // records, each parsed, then passed through the driver's stream (hemisphere choice and
 // plausibility gate) as the driver does; the whole input is parsed as one report too.
-#include "covtrack/devices/hydra/hydra_report.hpp"
-#include "covtrack/devices/hydra/hydra_stream.hpp"
 #include "fuzz/fuzz_support.hpp"
+#include "hydra_report.hpp"
+#include "hydra_stream.hpp"
 
 using namespace covtrack;
 using namespace covtrack::hydra;

@@ -1,8 +1,8 @@
 // A Lenz track layout file (sections, occupancy inputs, segments, the train), read
 // through a real file as the driver reads it; a layout that loads gives finite poses
 // all along its loop.
-#include "covtrack/devices/lenz/layout_config.hpp"
 #include "fuzz/fuzz_support.hpp"
+#include "layout_config.hpp"
 
 using namespace covtrack;
 

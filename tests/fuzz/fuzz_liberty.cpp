@@ -1,7 +1,7 @@
 // Polhemus LIBERTY / PATRIOT binary frames: the first byte picks the output format
 // (units, extra items), the rest is the serial stream.
-#include "covtrack/devices/serial6dof/liberty_decoder.hpp"
 #include "fuzz/serial6dof_checks.hpp"
+#include "liberty_decoder.hpp"
 
 using namespace covtrack;
 using namespace covtrack::serial6dof;

@@ -2,9 +2,9 @@
 // chunks, then the meaning of each frame as a reply and as a request.
 #include <variant>
 
-#include "covtrack/devices/lenz/xpressnet_framing.hpp"
-#include "covtrack/devices/lenz/xpressnet_messages.hpp"
 #include "fuzz/fuzz_support.hpp"
+#include "xpressnet_framing.hpp"
+#include "xpressnet_messages.hpp"
 
 using namespace covtrack;
 

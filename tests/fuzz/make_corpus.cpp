@@ -11,12 +11,12 @@
 #include <covtrack/device_claim_t.hpp>
 #include <covtrack/device_status_t.hpp>
 
-#include "covtrack/devices/hydra/hydra_report.hpp"
-#include "covtrack/devices/lenz/xpressnet_messages.hpp"
-#include "covtrack/devices/serial6dof/record_encoder.hpp"
 #include "covtrack/lcmlog/log_writer.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/pose_message.hpp"
+#include "hydra_report.hpp"
+#include "record_encoder.hpp"
+#include "xpressnet_messages.hpp"
 
 using namespace covtrack;
 using Bytes = std::vector<std::uint8_t>;

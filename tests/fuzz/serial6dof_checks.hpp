@@ -5,8 +5,8 @@
 #include <variant>
 #include <vector>
 
-#include "covtrack/devices/serial6dof/tracker_record.hpp"
 #include "fuzz/fuzz_support.hpp"
+#include "tracker_record.hpp"
 
 namespace covtrack::fuzz {
 

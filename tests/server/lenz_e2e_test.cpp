@@ -23,10 +23,10 @@
 #include <covtrack/raw_bytes_t.hpp>
 #include <covtrack/truth_pose_t.hpp>
 
-#include "covtrack/devices/lenz/dead_reckoning.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/pose_message.hpp"
 #include "daemon_process.hpp"
+#include "dead_reckoning.hpp"
 
 using namespace covtrack;
 

@@ -15,7 +15,7 @@
 #include <covtrack/device_status_t.hpp>
 #include <covtrack/pose_cov_t.hpp>
 
-#include "covtrack/emulate6dof/emulator.hpp"
+#include "covtrack/emulators/serial6dof/emulator.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/pose_message.hpp"
 #include "daemon_process.hpp"

@@ -23,7 +23,7 @@
 
 #include <covtrack/pose_cov_t.hpp>
 
-#include "covtrack/devices/vrpn/cookie.hpp"
+#include "covtrack/vrpn/cookie.hpp"
 #include "daemon_process.hpp"
 #include "vrpn_test_client.hpp"
 

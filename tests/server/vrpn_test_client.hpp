@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "covtrack/devices/vrpn/message_names.hpp"
-#include "covtrack/devices/vrpn/session.hpp"
-#include "covtrack/devices/vrpn/socket.hpp"
-#include "covtrack/devices/vrpn/system_messages.hpp"
-#include "covtrack/devices/vrpn/tracker_report.hpp"
+#include "covtrack/vrpn/message_names.hpp"
+#include "covtrack/vrpn/session.hpp"
+#include "covtrack/vrpn/socket.hpp"
+#include "covtrack/vrpn/system_messages.hpp"
+#include "covtrack/vrpn/tracker_report.hpp"
 
 namespace covtrack::test {
 

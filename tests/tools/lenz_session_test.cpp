@@ -12,13 +12,13 @@
 #include <covtrack/raw_bytes_t.hpp>
 #include <covtrack/truth_pose_t.hpp>
 
-#include "covtrack/devices/lenz/dead_reckoning.hpp"
-#include "covtrack/devices/lenz/feedback_state.hpp"
-#include "covtrack/devices/lenz/layout_config.hpp"
-#include "covtrack/devices/lenz/train_poses.hpp"
-#include "covtrack/devices/lenz/xpressnet_framing.hpp"
 #include "covtrack/lcmlog/log_reader.hpp"
 #include "covtrack/protocol/pose_message.hpp"
+#include "dead_reckoning.hpp"
+#include "feedback_state.hpp"
+#include "layout_config.hpp"
+#include "train_poses.hpp"
+#include "xpressnet_framing.hpp"
 
 using namespace covtrack;
 using namespace covtrack::lenz;

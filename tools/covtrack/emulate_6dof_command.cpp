@@ -14,11 +14,12 @@
 #include <covtrack/truth_pose_t.hpp>
 
 #include "commands.hpp"
+#include "covtrack/emulators/serial6dof/emulator.hpp"
 #include "covtrack/program/command_line.hpp"
-#include "covtrack/emulate6dof/emulator.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 #include "covtrack/protocol/pose_message.hpp"
+#include "device_model.hpp"
 #include "stop_signal.hpp"
 
 namespace covtrack::cli {

@@ -14,12 +14,12 @@
 #include <covtrack/truth_pose_t.hpp>
 
 #include "commands.hpp"
-#include "covtrack/program/command_line.hpp"
-#include "covtrack/devices/lenz/layout_config.hpp"
 #include "covtrack/emulators/lenz/lenz_emulator.hpp"
+#include "covtrack/program/command_line.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
 #include "covtrack/protocol/pose_message.hpp"
+#include "layout_config.hpp"
 #include "stop_signal.hpp"
 
 namespace covtrack::cli {

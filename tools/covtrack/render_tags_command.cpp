@@ -22,7 +22,7 @@
 #include "commands.hpp"
 #include "covtrack/program/command_line.hpp"
 #include "covtrack/devices/fiducial/fiducial_config.hpp"
-#include "covtrack/devices/fiducial/tag_image_formation.hpp"
+#include "covtrack/emulators/fiducial/tag_image_formation.hpp"
 
 namespace covtrack::cli {
 namespace {

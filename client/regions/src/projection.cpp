@@ -318,6 +318,95 @@ void linear_block(const Camera& camera, const Pose& T, const Mat6& covariance,
   }
 }
 
+// Strongly rotated poses (above UnscentedParams::cubature_min_rotation_trace_rad2) take
+// the fifth-degree cubature rule for a Gaussian (McNamee and Stenger): the centre, +-sqrt(3)
+// along each column of a square root of the covariance, and +-sqrt(3) along both columns of
+// every pair: 2n^2 + 1 = 73 points, exact for every moment of the perturbation up to degree
+// five where the unscented transform's 13 are exact to degree three. The pixel's covariance
+// then holds every product of two second-order terms (rotation about two axes at once),
+// which the unscented transform misses and which is most of its error at 10 degrees.
+// Weights 2/3 (centre), (4 - n)/18 = -1/9 (axes), 1/36 (pairs); the negative ones can make
+// the covariance indefinite on a map that bends hard, which repair_psd reports. It costs
+// about six times the unscented transform per object (bench_regions, EightDegrees).
+constexpr int kCubaturePoints = 2 * kN * kN + 1;
+
+// Structure-of-arrays as SigmaPoses: element e of pose i at pose[e][i]; pose 0 unperturbed.
+struct CubaturePoses {
+  double pose[12][kCubaturePoints];
+  double w[kCubaturePoints];
+};
+
+// The poses T Exp(xi) of the points, through exp_sigma_poses six columns at a time (each
+// call gives +-column): first the axes, then c_i + c_j and c_i - c_j of every pair.
+CubaturePoses make_cubature_poses(const UncertainPose& pose) {
+  Eigen::SelfAdjointEigenSolver<Mat6> eig(pose.covariance);
+  const Mat6 root = std::sqrt(3.0) * eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal() *
+                    eig.eigenvectors().transpose();
+  std::vector<Vec6> columns;
+  columns.reserve(kN + kN * (kN - 1));
+  for (int i = 0; i < kN; ++i) columns.push_back(root.col(i));
+  for (int i = 0; i < kN; ++i)
+    for (int j = i + 1; j < kN; ++j) columns.push_back(root.col(i) + root.col(j)), columns.push_back(root.col(i) - root.col(j));
+  const Mat3 R = pose.T.linear();
+  const Vec3 t = pose.T.translation();
+  CubaturePoses c;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) c.pose[3 * i + j][0] = R(i, j);
+    c.pose[9 + i][0] = t[i];
+  }
+  c.w[0] = 1 + (kN * kN - 7.0 * kN) / 18;
+  for (std::size_t first = 0; first < columns.size(); first += kN) {
+    SigmaColumns S;
+    for (int r = 0; r < kN; ++r)
+      for (int l = 0; l < kLanes; ++l) S[r][l] = l < kN ? columns[first + l][r] : 0.0;
+    double poses[12][kSigmaPoints];
+    exp_sigma_poses(R, t, S, poses);
+    for (int k = 1; k < kSigmaPoints; ++k) {
+      for (int e = 0; e < 12; ++e) c.pose[e][first * 2 + k] = poses[e][k];
+      c.w[first * 2 + k] = first == 0 ? (4.0 - kN) / 18 : 1.0 / 36;
+    }
+  }
+  return c;
+}
+
+// What unscented_block gives, through the cubature points (each weighted by its own w).
+COVTRACK_VECTOR_CLONES
+void cubature_block(const Camera& camera, const CubaturePoses& c, const double (&px)[kBlock],
+                    const double (&py)[kBlock], const double (&pz)[kBlock], UnscentedBlock& out) {
+  const Camera cam = camera;
+  double u[kCubaturePoints][kBlock], v[kCubaturePoints][kBlock], z[kCubaturePoints][kBlock];
+  double mu[kBlock] = {}, mv[kBlock] = {}, mz[kBlock] = {}, zmin[kBlock], r2max[kBlock] = {};
+  for (int j = 0; j < kBlock; ++j) zmin[j] = INFINITY;
+  for (int i = 0; i < kCubaturePoints; ++i) {
+    double m[12];
+    for (int e = 0; e < 12; ++e) m[e] = c.pose[e][i];
+    const double w = c.w[i];
+    for (int j = 0; j < kBlock; ++j) {
+      const double x = m[0] * px[j] + m[1] * py[j] + m[2] * pz[j] + m[9];
+      const double y = m[3] * px[j] + m[4] * py[j] + m[5] * pz[j] + m[10];
+      const double zz = z[i][j] = m[6] * px[j] + m[7] * py[j] + m[8] * pz[j] + m[11];
+      const double iz = 1 / zz, xn = x * iz, yn = y * iz;
+      cam.pixel_of_normalised(xn, yn, u[i][j], v[i][j]);
+      mu[j] += w * u[i][j], mv[j] += w * v[i][j], mz[j] += w * zz;
+      zmin[j] = std::min(zmin[j], zz);
+      r2max[j] = std::max(r2max[j], xn * xn + yn * yn);
+    }
+  }
+  double cuu[kBlock] = {}, cuv[kBlock] = {}, cvv[kBlock] = {}, zvar[kBlock] = {};
+  for (int i = 0; i < kCubaturePoints; ++i) {
+    const double w = c.w[i];
+    for (int j = 0; j < kBlock; ++j) {
+      const double du = u[i][j] - mu[j], dv = v[i][j] - mv[j], dz = z[i][j] - mz[j];
+      cuu[j] += w * du * du, cuv[j] += w * du * dv, cvv[j] += w * dv * dv, zvar[j] += w * dz * dz;
+    }
+  }
+  for (int j = 0; j < kBlock; ++j) {
+    out.u0[j] = u[0][j], out.v0[j] = v[0][j], out.z0[j] = z[0][j], out.zmin[j] = zmin[j], out.r2max[j] = r2max[j];
+    out.zvar[j] = zvar[j], out.mean_u[j] = mu[j], out.mean_v[j] = mv[j];
+    out.cuu[j] = cuu[j], out.cuv[j] = cuv[j], out.cvv[j] = cvv[j];
+  }
+}
+
 // Block `first` of the points as structure-of-arrays; a short last block repeats its first
 // point. Returns how many of the block's lanes are real points.
 int load_block(std::span<const Vec3> points, std::size_t first, double (&px)[kBlock],
@@ -368,17 +457,18 @@ void project_linear(const Camera& camera, const UncertainPose& pose,
   }
 }
 
-void project_unscented(const Camera& camera, const UncertainPose& pose,
-                       std::span<const Vec3> points, const ProjectionOptions& o,
-                       const ProjectionFlags& shared, std::vector<ProjectedVertex>& out) {
-  const SigmaPoses sigma = make_sigma_poses(pose, o.unscented);
+// The vertices' pixels from the moments that fill_block(px, py, pz, block) gives for each
+// block of them: the unscented transform's or the cubature's.
+template <class FillBlock>
+void project_from_moments(const Camera& camera, std::span<const Vec3> points, const ProjectionOptions& o,
+                          const ProjectionFlags& shared, std::vector<ProjectedVertex>& out, FillBlock&& fill_block) {
   const bool add_intrinsic = o.add_intrinsic_uncertainty && !camera.intrinsic_sigmas_px.isZero();
   const double fold_r2 = camera.distortion_fold_r2();
   UnscentedBlock b;
   for (std::size_t first = 0; first < points.size(); first += kBlock) {
     double px[kBlock], py[kBlock], pz[kBlock];
     const int count = load_block(points, first, px, py, pz);
-    unscented_block(camera, sigma, px, py, pz, b);
+    fill_block(px, py, pz, b);
     for (int j = 0; j < count; ++j) {
       ProjectedVertex& v = start_vertex(out, b.z0[j], shared, o);
       if (v.flags.behind_camera) continue;
@@ -398,6 +488,21 @@ void project_unscented(const Camera& camera, const UncertainPose& pose,
       if (add_intrinsic) v.covariance_px2 += camera.intrinsic_covariance_at(unperturbed);
     }
   }
+}
+
+void project_unscented(const Camera& camera, const UncertainPose& pose,
+                       std::span<const Vec3> points, const ProjectionOptions& o,
+                       const ProjectionFlags& shared, std::vector<ProjectedVertex>& out) {
+  if (pose.covariance.bottomRightCorner<3, 3>().trace() > o.unscented.cubature_min_rotation_trace_rad2) {
+    const CubaturePoses c = make_cubature_poses(pose);
+    return project_from_moments(camera, points, o, shared, out, [&](auto& px, auto& py, auto& pz, auto& b) {
+      cubature_block(camera, c, px, py, pz, b);
+    });
+  }
+  const SigmaPoses sigma = make_sigma_poses(pose, o.unscented);
+  project_from_moments(camera, points, o, shared, out, [&](auto& px, auto& py, auto& pz, auto& b) {
+    unscented_block(camera, sigma, px, py, pz, b);
+  });
 }
 
 }  // namespace

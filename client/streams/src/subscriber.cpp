@@ -75,7 +75,10 @@ struct Subscriber::Impl final : UdpmReceiver::Handler {
     std::shared_ptr<const CallbackList> matched_for;
     std::vector<const Subscriber::PoseCallback*> matched;
   };
-  std::map<std::string, Stream> streams;  // by "device/sensor"
+  std::map<std::string, Stream> streams;  // by "device/sensor"; never erased, so pointers stay valid
+  // The same streams by pose channel, for the dispatch thread alone (no lock): the channel
+  // is parsed and its "device/sensor" key built once per stream, not once per message.
+  std::unordered_map<std::string, Stream*, TextHash, std::equal_to<>> stream_by_channel;
   std::map<std::string, DeviceTracker> devices;  // by device name
   RejectionTally rejections;  // every rejected message, of any channel
   std::optional<AuthKey> key;
@@ -161,11 +164,28 @@ struct Subscriber::Impl final : UdpmReceiver::Handler {
     rejections.add(lcm_wire::to_string(why.fault), "datagram from " + from, why.describe());
   }
 
+  // The stream a pose channel names, made at its first message; null when the channel
+  // names none. Dispatch thread only.
+  Stream* stream_of(std::string_view channel) {
+    if (auto it = stream_by_channel.find(channel); it != stream_by_channel.end()) return it->second;
+    const auto id = parse_pose_channel(channel);
+    if (!id) return nullptr;
+    Stream* s = nullptr;
+    {
+      std::lock_guard lock(mutex);
+      s = &streams.try_emplace(id->key(), options.sequence_window).first->second;
+      s->state.id = *id;
+    }
+    if (stream_by_channel.size() >= kChannelVerdicts) stream_by_channel.clear();
+    stream_by_channel.emplace(channel, s);
+    return s;
+  }
+
   void on_pose(std::string_view channel, std::span<const std::byte> bytes) {
     const std::int64_t now = now_us();
     const auto decoded = decode_pose(channel, bytes);
-    const auto id = parse_pose_channel(channel);
-    if (!id) return reject_unowned(std::string(channel), decoded.error());
+    Stream* const stream = stream_of(channel);
+    if (!stream) return reject_unowned(std::string(channel), decoded.error());
     std::optional<std::pair<std::string, std::string>> rejection;  // reason, description
     if (!decoded)
       rejection.emplace(to_string(decoded.error().fault), decoded.error().describe());
@@ -173,12 +193,10 @@ struct Subscriber::Impl final : UdpmReceiver::Handler {
       rejection.emplace("invalid pose", *invalid);
 
     const auto current_callbacks = callback_snapshot();
-    std::optional<TrackedTransform> accepted;
-    std::vector<const PoseCallback*> to_call;
+    const std::vector<const PoseCallback*>* to_call = nullptr;
     {
       std::lock_guard lock(mutex);
-      Stream& s = streams.try_emplace(id->key(), options.sequence_window).first->second;
-      s.state.id = *id;
+      Stream& s = *stream;
       // A decoded message names this stream (decode_pose checks it), so its sequence
       // number counts even if its values are rejected: it arrived, it is no loss.
       auto order = SequenceTracker::Verdict::First;
@@ -202,12 +220,12 @@ struct Subscriber::Impl final : UdpmReceiver::Handler {
       s.state.stale = false;
       ++s.state.counters.received;
       s.state.latest = to_tracked_transform(*decoded, now);
-      accepted = s.state.latest;
-      to_call = matching_callbacks(s, current_callbacks);
+      to_call = &matching_callbacks(s, current_callbacks);
     }
     // Outside the lock: a callback may read latest() or register another callback.
-    // current_callbacks keeps the functions alive while they run.
-    for (const PoseCallback* cb : to_call) (*cb)(*accepted);
+    // current_callbacks keeps the functions alive while they run. Only this thread writes
+    // a stream's latest report and its matched callbacks, so both are read without a copy.
+    for (const PoseCallback* cb : *to_call) (*cb)(*stream->state.latest);
   }
 
   // The callbacks of `current` whose pattern matches the stream (call with mutex held).

@@ -6,15 +6,15 @@
 #include <hidapi/hidapi.h>
 
 #include "covtrack/devices/file_kind.hpp"
-#include "covtrack/devices/hydra/hydra_report.hpp"
-#include "covtrack/devices/hydra/hydra_stream.hpp"
 #include "covtrack/devices/valid_frame_watchdog.hpp"
-#include "covtrack/protocol/clock.hpp"
+#include "hydra_report.hpp"
+#include "hydra_stream.hpp"
 
 namespace covtrack::hydra {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using Clock = DriverClock;
+constexpr std::chrono::milliseconds kReadPoll(20);  // a stop is noticed within this
 // VRPN's experience: a base may need the mode switch repeated; give it this long.
 constexpr double kModeSwitchRetry_s = 2.0;
 
@@ -29,7 +29,7 @@ std::string find_hydra_path() {
 
 class HydraDriver final : public Driver {
  public:
-  explicit HydraDriver(HydraConfig config) : config_(std::move(config)) {}
+  HydraDriver(HydraConfig config, DriverClock& clock) : config_(std::move(config)), clock_(clock) {}
 
   Result<void> run(SampleSink& sink, std::stop_token stop) override {
     if (hid_init() != 0) return fail("Razer Hydra: hidapi cannot start");
@@ -52,25 +52,26 @@ class HydraDriver final : public Driver {
   Result<void> stream(hid_device* dev, SampleSink& sink, std::stop_token stop) {
     const double period_s = 1.0 / config_.rate_hz;
     const auto motion = motion_mode_feature_report();
-    auto last_report = Clock::now(), last_switch = Clock::time_point{};
+    auto last_report = clock_.now(), last_switch = Clock::time_point{};
     // Reports that do not parse are no sign of life: only a parsed one feeds the watchdog.
     ValidFrameWatchdog watchdog(config_.no_valid_frames_s, last_report);
     std::uint64_t bad_reports = 0;
     std::array<std::uint8_t, 64> buffer{};
     bool lost = false;
     while (!stop.stop_requested()) {
-      const double silent_s = std::chrono::duration<double>(Clock::now() - last_report).count();
+      const double silent_s = std::chrono::duration<double>(clock_.now() - last_report).count();
       if (silent_s > kModeSwitchRetry_s &&
-          std::chrono::duration<double>(Clock::now() - last_switch).count() > kModeSwitchRetry_s) {
+          std::chrono::duration<double>(clock_.now() - last_switch).count() > kModeSwitchRetry_s) {
         hid_send_feature_report(dev, motion.data(), motion.size());
-        last_switch = Clock::now();
+        last_switch = clock_.now();
       }
-      if (auto expired = watchdog.expired(Clock::now())) {
+      if (auto expired = watchdog.expired(clock_.now())) {
         report_lost(sink);
         return fail(fmt::format("Razer Hydra: {} ({} reports that did not parse; controllers reported LOST)",
                                 *expired, bad_reports));
       }
-      const int n = hid_read_timeout(dev, buffer.data(), buffer.size(), 20);
+      const auto wait = clock_.io_timeout(stop, clock_.now() + kReadPoll, kReadPoll);
+      const int n = hid_read_timeout(dev, buffer.data(), buffer.size(), static_cast<int>(wait.count()));
       if (n < 0) {
         report_lost(sink);
         return fail("Razer Hydra: device disconnected (controllers reported LOST)");
@@ -88,10 +89,10 @@ class HydraDriver final : public Driver {
         sink.count_error(report.error().message);
         continue;
       }
-      last_report = Clock::now();
+      last_report = clock_.now();
       watchdog.valid_frame(last_report);
       lost = false;
-      auto out = stream_.on_report(*report, now_us());
+      auto out = stream_.on_report(*report, clock_.now_us());
       for (const auto& line : out.errors) sink.count_error(line);
       for (const auto& sample : out.samples) sink.pose(sample);
     }
@@ -99,17 +100,18 @@ class HydraDriver final : public Driver {
   }
 
   void report_lost(SampleSink& sink) {
-    for (const auto& sample : stream_.lost(now_us())) sink.pose(sample);
+    for (const auto& sample : stream_.lost(clock_.now_us())) sink.pose(sample);
   }
 
   HydraConfig config_;
+  DriverClock& clock_;
   HydraStream stream_{config_};
 };
 
 }  // namespace
 
-std::unique_ptr<Driver> make_hydra_driver(const HydraConfig& config) {
-  return std::make_unique<HydraDriver>(config);
+std::unique_ptr<Driver> make_hydra_driver(const HydraConfig& config, DriverClock& clock) {
+  return std::make_unique<HydraDriver>(config, clock);
 }
 
 }  // namespace covtrack::hydra

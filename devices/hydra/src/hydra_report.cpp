@@ -1,4 +1,4 @@
-#include "covtrack/devices/hydra/hydra_report.hpp"
+#include "hydra_report.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "covtrack/devices/hydra/hydra_stream.hpp"
+#include "hydra_stream.hpp"
 
 #include <limits>
 

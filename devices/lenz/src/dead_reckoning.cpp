@@ -1,4 +1,4 @@
-#include "covtrack/devices/lenz/dead_reckoning.hpp"
+#include "dead_reckoning.hpp"
 
 #include <algorithm>
 #include <cmath>

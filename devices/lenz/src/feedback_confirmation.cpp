@@ -1,4 +1,4 @@
-#include "covtrack/devices/lenz/feedback_confirmation.hpp"
+#include "feedback_confirmation.hpp"
 
 #include <fmt/format.h>
 

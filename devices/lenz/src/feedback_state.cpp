@@ -1,4 +1,4 @@
-#include "covtrack/devices/lenz/feedback_state.hpp"
+#include "feedback_state.hpp"
 
 namespace covtrack::lenz {
 

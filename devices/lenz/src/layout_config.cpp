@@ -1,4 +1,4 @@
-#include "covtrack/devices/lenz/layout_config.hpp"
+#include "layout_config.hpp"
 
 #include <charconv>
 #include <numbers>

@@ -1,13 +1,13 @@
-#include "covtrack/devices/lenz/lenz_config.hpp"
+#include "covtrack/devices/lenz/lenz_driver.hpp"
 
 #include <filesystem>
 
 #include <fmt/format.h>
 
 #include "covtrack/devices/device_keys.hpp"
-#include "covtrack/devices/lenz/layout_config.hpp"
 #include "covtrack/devices/serial/baud_rate.hpp"
 #include "covtrack/devices/valid_frame_watchdog.hpp"
+#include "layout_config.hpp"
 
 namespace covtrack::lenz {
 

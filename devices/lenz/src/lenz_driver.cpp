@@ -7,11 +7,12 @@
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/lenz/feedback_confirmation.hpp"
-#include "covtrack/devices/lenz/xpressnet_framing.hpp"
-#include "covtrack/devices/lenz/xpressnet_messages.hpp"
 #include "covtrack/devices/serial/serial_port.hpp"
 #include "covtrack/devices/valid_frame_watchdog.hpp"
+#include "feedback_confirmation.hpp"
+#include "train_poses.hpp"
+#include "xpressnet_framing.hpp"
+#include "xpressnet_messages.hpp"
 
 namespace covtrack::lenz {
 namespace {

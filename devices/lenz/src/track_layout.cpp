@@ -1,4 +1,4 @@
-#include "covtrack/devices/lenz/track_layout.hpp"
+#include "track_layout.hpp"
 
 #include <algorithm>
 #include <cmath>

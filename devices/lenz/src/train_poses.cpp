@@ -1,4 +1,4 @@
-#include "covtrack/devices/lenz/train_poses.hpp"
+#include "train_poses.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "covtrack/devices/lenz/xpressnet_framing.hpp"
+#include "xpressnet_framing.hpp"
 
 namespace covtrack::lenz {
 namespace {

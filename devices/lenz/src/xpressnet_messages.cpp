@@ -1,4 +1,4 @@
-#include "covtrack/devices/lenz/xpressnet_messages.hpp"
+#include "xpressnet_messages.hpp"
 
 #include <fmt/format.h>
 

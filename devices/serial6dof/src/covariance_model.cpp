@@ -1,4 +1,4 @@
-#include "covtrack/devices/serial6dof/covariance_model.hpp"
+#include "covariance_model.hpp"
 
 namespace covtrack::serial6dof {
 

@@ -1,4 +1,4 @@
-#include "covtrack/devices/serial6dof/device_model.hpp"
+#include "device_model.hpp"
 
 #include <algorithm>
 #include <array>

@@ -2,10 +2,16 @@
 // One protocol's conversation with a unit: the reset and configuration sequence up to
 // continuous output, and the decoding of what it then streams.
 #include <memory>
+#include <optional>
 #include <span>
+#include <string>
+#include <string_view>
 
-#include "covtrack/devices/serial6dof/serial6dof_config.hpp"
+#include <fmt/format.h>
+
+#include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 #include "device_link.hpp"
+#include "tracker_record.hpp"
 
 namespace covtrack::serial6dof {
 
@@ -24,6 +30,30 @@ class DeviceSession {
 std::unique_ptr<DeviceSession> make_fastrak_session(const Serial6dofConfig& config);
 std::unique_ptr<DeviceSession> make_liberty_session(const Serial6dofConfig& config);
 std::unique_ptr<DeviceSession> make_flock_session(const Serial6dofConfig& config);
+
+// What every protocol's session shares: its config, and its decoder, which is handed the
+// stream and asked for the counters.
+template <typename Decoder>
+class DecodingSession : public DeviceSession {
+ public:
+  DecodingSession(const Serial6dofConfig& config, const auto& format) : config_(config), decoder_(format) {}
+
+  std::vector<DecodedItem> feed(std::span<const std::uint8_t> b) override { return decoder_.feed(b); }
+  std::uint64_t resyncs() const override { return decoder_.resyncs(); }
+  std::uint64_t bad_records() const override { return decoder_.bad_records(); }
+  std::string last_problem() const override { return decoder_.last_problem(); }
+
+ protected:
+  // The error for a unit that did not answer (`what_and_when`) in time, with what to check.
+  std::unexpected<Error> no_answer(const DeviceLink& link, const std::string& what_and_when,
+                                   std::string_view unit_state) const {
+    return fail(fmt::format("{}: {} (check the port, the baud rate {} and that {})", link.path(), what_and_when,
+                            config_.baud, unit_state));
+  }
+
+  Serial6dofConfig config_;
+  Decoder decoder_;
+};
 
 // Reads and decodes until `accept` takes a reply, or `timeout_s` passes (nullopt).
 template <typename Accept>

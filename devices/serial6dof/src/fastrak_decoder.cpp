@@ -1,4 +1,4 @@
-#include "covtrack/devices/serial6dof/fastrak_decoder.hpp"
+#include "fastrak_decoder.hpp"
 
 #include <cmath>
 #include <cstring>

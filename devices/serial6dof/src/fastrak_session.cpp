@@ -4,16 +4,17 @@
 #include <fmt/format.h>
 
 #include "device_session.hpp"
+#include "fastrak_decoder.hpp"
 
 namespace covtrack::serial6dof {
 namespace {
 
 const char* units_name(Units u) { return u == Units::Inches ? "inches" : "cm"; }
 
-class FastrakSession final : public DeviceSession {
+class FastrakSession final : public DecodingSession<FastrakDecoder> {
  public:
   explicit FastrakSession(const Serial6dofConfig& c)
-      : config_(c), decoder_({c.units, c.fastrak_extras, true}) {}
+      : DecodingSession(c, FastrakFormat{c.units, c.fastrak_extras, true}) {}
 
   Result<void> start(DeviceLink& link, bool reset) override {
     using namespace std::chrono_literals;
@@ -33,9 +34,8 @@ class FastrakSession final : public DeviceSession {
     if (!reply) return std::unexpected(reply.error());
     if (link.stopped()) return {};
     if (!*reply)
-      return fail(fmt::format("{}: no status record within {} s of 'S' (check the port, the baud "
-                              "rate {} and that the unit is on)", link.path(),
-                              config_.reply_timeout_s, config_.baud));
+      return no_answer(link, fmt::format("no status record within {} s of 'S'", config_.reply_timeout_s),
+                       "the unit is on");
     const auto units = fastrak_status_units(**reply);
     if (!units) return fail(fmt::format("{}: malformed status record", link.path()));
     if (*units != config_.units)
@@ -44,15 +44,6 @@ class FastrakSession final : public DeviceSession {
     if (auto r = link.send("f"); !r) return r;
     return link.send("C");
   }
-
-  std::vector<DecodedItem> feed(std::span<const std::uint8_t> b) override { return decoder_.feed(b); }
-  std::uint64_t resyncs() const override { return decoder_.resyncs(); }
-  std::uint64_t bad_records() const override { return decoder_.bad_records(); }
-  std::string last_problem() const override { return decoder_.last_problem(); }
-
- private:
-  Serial6dofConfig config_;
-  FastrakDecoder decoder_;
 };
 
 }  // namespace

@@ -1,6 +1,6 @@
-#include "covtrack/devices/serial6dof/flock_decoder.hpp"
+#include "flock_decoder.hpp"
 
-#include "covtrack/devices/serial6dof/phased_word.hpp"
+#include "phased_word.hpp"
 #include "record_check.hpp"
 
 namespace covtrack::serial6dof {

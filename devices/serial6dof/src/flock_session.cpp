@@ -3,8 +3,8 @@
 // the units), P 35 g (group mode), ] per bird (POSITION/QUATERNION), @ (stream).
 #include <fmt/format.h>
 
-#include "covtrack/devices/serial6dof/flock_decoder.hpp"
 #include "device_session.hpp"
+#include "flock_decoder.hpp"
 
 namespace covtrack::serial6dof {
 namespace {
@@ -24,9 +24,9 @@ FlockFormat format_of(const Serial6dofConfig& c) {
   return {c.flock_position_scale_in, c.stations.size() > 1, c.stations.front().number};
 }
 
-class FlockSession final : public DeviceSession {
+class FlockSession final : public DecodingSession<FlockDecoder> {
  public:
-  explicit FlockSession(const Serial6dofConfig& c) : config_(c), decoder_(format_of(c)) {}
+  explicit FlockSession(const Serial6dofConfig& c) : DecodingSession(c, format_of(c)) {}
 
   Result<void> start(DeviceLink& link, bool reset) override {
     using namespace std::chrono_literals;
@@ -51,11 +51,6 @@ class FlockSession final : public DeviceSession {
     return link.send(bytes({kStream}));
   }
 
-  std::vector<DecodedItem> feed(std::span<const std::uint8_t> b) override { return decoder_.feed(b); }
-  std::uint64_t resyncs() const override { return decoder_.resyncs(); }
-  std::uint64_t bad_records() const override { return decoder_.bad_records(); }
-  std::string last_problem() const override { return decoder_.last_problem(); }
-
  private:
   // The answer to an examine is two raw bytes (LS first), outside any record framing.
   Result<void> confirm_scaling(DeviceLink& link) {
@@ -66,9 +61,9 @@ class FlockSession final : public DeviceSession {
       if (auto n = link.read(answer, std::chrono::milliseconds(20)); !n) return std::unexpected(n.error());
     if (link.stopped()) return {};
     if (answer.size() < 2)
-      return fail(fmt::format("{}: no answer to examine position scaling within {} s (check the "
-                              "port, the baud rate {} and that the bird is on and not asleep)",
-                              link.path(), config_.reply_timeout_s, config_.baud));
+      return no_answer(link,
+                       fmt::format("no answer to examine position scaling within {} s", config_.reply_timeout_s),
+                       "the bird is on and not asleep");
     const int code = answer[0] | answer[1] << 8;
     // 0: 36 in, 1: 72 in (standard transmitter). The extended-range transmitter's 144 in
     // is not reported by this parameter, so it cannot be confirmed here.
@@ -82,8 +77,6 @@ class FlockSession final : public DeviceSession {
     return {};
   }
 
-  Serial6dofConfig config_;
-  FlockDecoder decoder_;
 };
 
 }  // namespace

@@ -1,4 +1,4 @@
-#include "covtrack/devices/serial6dof/liberty_decoder.hpp"
+#include "liberty_decoder.hpp"
 
 #include <fmt/format.h>
 

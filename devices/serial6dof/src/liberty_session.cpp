@@ -5,14 +5,15 @@
 
 #include "device_session.hpp"
 #include "float_le.hpp"
+#include "liberty_decoder.hpp"
 
 namespace covtrack::serial6dof {
 namespace {
 
-class LibertySession final : public DeviceSession {
+class LibertySession final : public DecodingSession<LibertyDecoder> {
  public:
   explicit LibertySession(const Serial6dofConfig& c)
-      : config_(c), decoder_({c.units, c.liberty_extras}) {}
+      : DecodingSession(c, LibertyFormat{c.units, c.liberty_extras}) {}
 
   Result<void> start(DeviceLink& link, bool reset) override {
     using namespace std::chrono_literals;
@@ -47,11 +48,6 @@ class LibertySession final : public DeviceSession {
     return link.send("C\r");
   }
 
-  std::vector<DecodedItem> feed(std::span<const std::uint8_t> b) override { return decoder_.feed(b); }
-  std::uint64_t resyncs() const override { return decoder_.resyncs(); }
-  std::uint64_t bad_records() const override { return decoder_.bad_records(); }
-  std::string last_problem() const override { return decoder_.last_problem(); }
-
  private:
   Result<std::optional<DeviceReply>> await(DeviceLink& link, char command) {
     return await_reply(link, *this, config_.reply_timeout_s,
@@ -59,13 +55,10 @@ class LibertySession final : public DeviceSession {
   }
   Result<void> no_reply(DeviceLink& link, const char* what) {
     if (link.stopped()) return {};
-    return fail(fmt::format("{}: no answer to {} within {} s (check the port, the baud rate {} "
-                            "and that the unit is on)", link.path(), what, config_.reply_timeout_s,
-                            config_.baud));
+    return no_answer(link, fmt::format("no answer to {} within {} s", what, config_.reply_timeout_s),
+                     "the unit is on");
   }
 
-  Serial6dofConfig config_;
-  LibertyDecoder decoder_;
   std::string who_am_i_;
 };
 

@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/serial6dof/tracker_record.hpp"
+#include "tracker_record.hpp"
 
 namespace covtrack::serial6dof {
 

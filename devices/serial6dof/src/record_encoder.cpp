@@ -1,4 +1,4 @@
-#include "covtrack/devices/serial6dof/record_encoder.hpp"
+#include "record_encoder.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/serial6dof/phased_word.hpp"
+#include "phased_word.hpp"
 
 namespace covtrack::serial6dof {
 namespace {

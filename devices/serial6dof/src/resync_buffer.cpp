@@ -1,4 +1,4 @@
-#include "covtrack/devices/serial6dof/resync_buffer.hpp"
+#include "resync_buffer.hpp"
 
 #include <utility>
 

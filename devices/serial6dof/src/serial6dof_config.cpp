@@ -1,4 +1,4 @@
-#include "covtrack/devices/serial6dof/serial6dof_config.hpp"
+#include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 
 #include <algorithm>
 #include <array>
@@ -11,6 +11,7 @@
 #include "covtrack/devices/motion_limit_keys.hpp"
 #include "covtrack/devices/serial/baud_rate.hpp"
 #include "covtrack/protocol/channels.hpp"
+#include "device_model.hpp"
 
 namespace covtrack::serial6dof {
 namespace {

@@ -8,8 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "covariance_model.hpp"
 #include "covtrack/devices/serial/serial_port.hpp"
-#include "covtrack/devices/serial6dof/covariance_model.hpp"
 #include "device_session.hpp"
 
 namespace covtrack::serial6dof {

@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <random>
 
-#include "covtrack/devices/sim/sim_config.hpp"
+#include "covtrack/devices/sim/sim_driver.hpp"
 
 namespace covtrack::sim {
 

@@ -1,4 +1,4 @@
-#include "covtrack/devices/sim/sim_config.hpp"
+#include "covtrack/devices/sim/sim_driver.hpp"
 
 #include <set>
 

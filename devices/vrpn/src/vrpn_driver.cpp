@@ -13,24 +13,21 @@
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/vrpn/message_names.hpp"
-#include "covtrack/devices/vrpn/session.hpp"
-#include "covtrack/devices/vrpn/socket.hpp"
-#include "covtrack/devices/vrpn/tracker_report.hpp"
-#include "covtrack/protocol/clock.hpp"
+#include "covtrack/vrpn/message_names.hpp"
+#include "covtrack/vrpn/session.hpp"
+#include "covtrack/vrpn/socket.hpp"
+#include "covtrack/vrpn/tracker_report.hpp"
 
 namespace covtrack::vrpn {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using Clock = DriverClock;
 constexpr auto kPingPeriod = std::chrono::seconds(1);  // as often as a VRPN client pings
-constexpr int kPollMs = 20;                             // a stop is noticed within this
+constexpr std::chrono::milliseconds kPoll(20);          // a stop is noticed within this
 // A VRPN time stamp further than this from our clock comes from an unsynchronised host:
 // the arrival time is used instead.
 constexpr std::int64_t kMaxClockOffset_us = 1'000'000;
 constexpr double kSendTimeout_s = 1.0;
-
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 struct SensorState {
   std::string name;
@@ -42,7 +39,7 @@ struct SensorState {
 
 class VrpnDriver final : public Driver {
  public:
-  explicit VrpnDriver(VrpnConfig config) : config_(std::move(config)) {
+  VrpnDriver(VrpnConfig config, DriverClock& clock) : config_(std::move(config)), clock_(clock) {
     for (const auto& s : config_.sensors) sensors_[s.number] = SensorState{s.name, s.covariance};
   }
 
@@ -67,7 +64,7 @@ class VrpnDriver final : public Driver {
   Result<void> stream(const Socket& socket, SampleSink& sink, std::stop_token stop) {
     const std::string& device = config_.tracker.name;
     Session session({device}, {std::string(kTrackerPosQuat), std::string(kPing), std::string(kPong)});
-    const auto connected = Clock::now();
+    const auto connected = clock_.now();
     auto last_heard = connected, last_ping = Clock::time_point{};
     bool answered = false, announced = false;
     std::array<std::uint8_t, 8192> buffer{};
@@ -76,17 +73,18 @@ class VrpnDriver final : public Driver {
         if (auto sent = send_all(socket, session.take_output(), kSendTimeout_s); !sent)
           return fail("the connection broke: " + sent.error().message);
       pollfd p{socket.fd(), POLLIN, 0};
-      if (::poll(&p, 1, kPollMs) > 0) {
+      const int wait_ms = static_cast<int>(clock_.io_timeout(stop, clock_.now() + kPoll, kPoll).count());
+      if (::poll(&p, 1, wait_ms) > 0) {
         const ssize_t n = ::recv(socket.fd(), buffer.data(), buffer.size(), 0);
         if (n == 0) return fail("the VRPN server closed the connection");
         if (n < 0 && errno != EAGAIN && errno != EINTR)
           return fail(fmt::format("the connection broke: {}", std::strerror(errno)));
         if (n > 0) {
-          auto messages = session.receive(std::span(buffer.data(), static_cast<std::size_t>(n)), now_us());
+          auto messages = session.receive(std::span(buffer.data(), static_cast<std::size_t>(n)), clock_.now_us());
           if (!messages) return fail(messages.error().message);
           for (const auto& m : *messages) {
             if (m.sender != device) continue;  // another device served on the same connection
-            last_heard = Clock::now();
+            last_heard = clock_.now();
             answered = true;
             if (m.type == kTrackerPosQuat) report(m, sink);
           }
@@ -102,9 +100,9 @@ class VrpnDriver final : public Driver {
         sink.running(fmt::format("connected to {} ({})", config_.tracker.endpoint(), session.peer()->version));
         announced = true;
       }
-      if (Clock::now() - last_ping >= kPingPeriod) {
-        session.send(device, kPing, now_us(), {});
-        last_ping = Clock::now();
+      if (clock_.now() - last_ping >= kPingPeriod) {
+        session.send(device, kPing, clock_.now_us(), {});
+        last_ping = clock_.now();
       }
       if (seconds_since(last_heard) > config_.silence_timeout_s)
         return fail(answered ? fmt::format("nothing from '{}' for {:.1f} s", device, config_.silence_timeout_s)
@@ -127,7 +125,7 @@ class VrpnDriver final : public Driver {
       sink.count_drop();
       return;
     }
-    const std::int64_t arrival_us = now_us();
+    const std::int64_t arrival_us = clock_.now_us();
     std::int64_t t = m.time_us;
     if (std::llabs(t - arrival_us) > kMaxClockOffset_us) {
       if (!warned_clock_)
@@ -141,7 +139,7 @@ class VrpnDriver final : public Driver {
     s.covariance = sensor->covariance;
     sink.pose(s);
     sensor->last = s.T_parent_child;
-    sensor->last_report = Clock::now();
+    sensor->last_report = clock_.now();
     sensor->reported = true;
   }
 
@@ -164,7 +162,7 @@ class VrpnDriver final : public Driver {
   }
 
   void lose(SensorState& s, SampleSink& sink) {
-    PoseSample lost{s.name, config_.parent_frame, s.name, now_us()};
+    PoseSample lost{s.name, config_.parent_frame, s.name, clock_.now_us()};
     lost.status = TrackingStatus::Lost;
     lost.T_parent_child = s.last;
     lost.covariance = lost_covariance();
@@ -173,13 +171,18 @@ class VrpnDriver final : public Driver {
   }
 
   static constexpr std::int32_t kMaxSensorNumber = 65535;  // as the config allows
+  double seconds_since(Clock::time_point t) const { return std::chrono::duration<double>(clock_.now() - t).count(); }
+
   VrpnConfig config_;
+  DriverClock& clock_;
   std::map<std::int32_t, SensorState> sensors_;
   bool warned_clock_ = false;
 };
 
 }  // namespace
 
-std::unique_ptr<Driver> make_vrpn_driver(const VrpnConfig& config) { return std::make_unique<VrpnDriver>(config); }
+std::unique_ptr<Driver> make_vrpn_driver(const VrpnConfig& config, DriverClock& clock) {
+  return std::make_unique<VrpnDriver>(config, clock);
+}
 
 }  // namespace covtrack::vrpn

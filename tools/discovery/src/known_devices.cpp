@@ -2,13 +2,16 @@
 
 #include <fmt/format.h>
 
-#include "covtrack/devices/hydra/hydra_report.hpp"
+#include "covtrack/devices/hydra/hydra_driver.hpp"
+#include "covtrack/devices/lenz/lenz_driver.hpp"
+#include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
 
 namespace covtrack::discovery {
 
 const std::vector<KnownDevice>& known_devices() {
   static const std::vector<KnownDevice> table = {
-      {0x0403, 0x6001, "FTDI FT232 USB-serial (Lenz LI-USB; also common RS-232 adapters)", "lenz",
+      {lenz::kLiUsbVendorId, lenz::kLiUsbProductId,
+       "FTDI FT232 USB-serial (Lenz LI-USB; also common RS-232 adapters)", "lenz",
        "a Lenz LI-USB shows up as this chip; the same chip in a plain adapter may carry a "
        "FASTRAK, IS-900, LIBERTY or Flock (then use type fastrak/liberty/flock)"},
       {0x0403, 0x6015, "FTDI FT-X USB-serial adapter", "fastrak",
@@ -17,12 +20,14 @@ const std::vector<KnownDevice>& known_devices() {
        "an RS-232 adapter: set type to the tracker behind it (fastrak, liberty or flock)"},
       {0x067b, 0x2303, "Prolific PL2303 USB-serial adapter", "fastrak",
        "an RS-232 adapter: set type to the tracker behind it (fastrak, liberty or flock)"},
-      {0x0f44, 0xff20, "Polhemus LIBERTY (USB)", "liberty",
+      {serial6dof::kPolhemusVendorId, serial6dof::kLibertyProductId, "Polhemus LIBERTY (USB)",
+       "liberty",
        "its USB port needs the usbserial module bound to 0f44:ff20 for a tty; the RS-232 port "
        "works as it is"},
-      {0x0f44, 0xff21, "Polhemus LIBERTY (USB, firmware not loaded)", "",
+      {serial6dof::kPolhemusVendorId, serial6dof::kLibertyNoFirmwareProductId,
+       "Polhemus LIBERTY (USB, firmware not loaded)", "",
        "load its firmware first (fxload, Polhemus' Linux tools); it then re-appears as 0f44:ff20"},
-      {0x0f44, 0, "Polhemus USB device", "liberty",
+      {serial6dof::kPolhemusVendorId, 0, "Polhemus USB device", "liberty",
        "LIBERTY/PATRIOT speak type liberty, FASTRAK type fastrak; use its serial port"},
       {hydra::kVendorId, hydra::kProductId, "Razer Hydra", "hydra", "two controllers over HID feature reports"},
   };

@@ -11,7 +11,8 @@
 
 #include "covtrack/devices/config_reader.hpp"
 #include "covtrack/devices/driver.hpp"
-#include "covtrack/devices/vrpn/tracker_address.hpp"
+#include "covtrack/devices/driver_clock.hpp"
+#include "covtrack/vrpn/tracker_address.hpp"
 
 namespace covtrack::vrpn {
 
@@ -40,6 +41,8 @@ const TableSpec& vrpn_device_spec();
 const TableSpec& vrpn_sensor_spec();
 VrpnConfig read_vrpn_config(TableReader& device, const std::string& device_name);
 
-std::unique_ptr<Driver> make_vrpn_driver(const VrpnConfig& config);
+// Every timeout, ping and time stamp of the driver is on `clock`; connecting and sending
+// keep their own limits in real time (they wait on the operating system).
+std::unique_ptr<Driver> make_vrpn_driver(const VrpnConfig& config, DriverClock& clock = real_clock());
 
 }  // namespace covtrack::vrpn

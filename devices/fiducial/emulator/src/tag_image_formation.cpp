@@ -1,0 +1,205 @@
+#include "covtrack/emulators/fiducial/tag_image_formation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace covtrack::fiducial {
+namespace {
+
+using Polygon = std::vector<cv::Point2d>;
+
+// Sutherland-Hodgman against one axis-aligned half-plane: keeps the points whose
+// coordinate `axis` (0: x, 1: y) is <= bound (keep_below) or >= bound.
+Polygon clip(const Polygon& poly, int axis, double bound, bool keep_below) {
+  Polygon out;
+  const auto inside = [&](const cv::Point2d& p) {
+    const double c = axis == 0 ? p.x : p.y;
+    return keep_below ? c <= bound : c >= bound;
+  };
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const cv::Point2d& a = poly[i];
+    const cv::Point2d& b = poly[(i + 1) % poly.size()];
+    const bool ia = inside(a), ib = inside(b);
+    if (ia) out.push_back(a);
+    if (ia != ib) {
+      const double ca = axis == 0 ? a.x : a.y, cb = axis == 0 ? b.x : b.y;
+      out.push_back(a + (b - a) * ((bound - ca) / (cb - ca)));
+    }
+  }
+  return out;
+}
+
+double area(const Polygon& poly) {
+  double s = 0;
+  for (std::size_t i = 0; i < poly.size(); ++i) s += poly[i].cross(poly[(i + 1) % poly.size()]);
+  return std::abs(s) / 2;
+}
+
+// Adds value * (covered fraction) to every pixel the convex polygon touches: rows first
+// (one clip per band), then each pixel of the band.
+void add_polygon(cv::Mat& image, const Polygon& poly, float value) {
+  double y_lo = 1e18, y_hi = -1e18;
+  for (const auto& p : poly) y_lo = std::min(y_lo, p.y), y_hi = std::max(y_hi, p.y);
+  const int r0 = std::max(0, static_cast<int>(std::floor(y_lo + 0.5)));
+  const int r1 = std::min(image.rows - 1, static_cast<int>(std::floor(y_hi + 0.5)));
+  for (int r = r0; r <= r1; ++r) {
+    const Polygon band = clip(clip(poly, 1, r - 0.5, false), 1, r + 0.5, true);
+    if (band.size() < 3) continue;
+    double x_lo = 1e18, x_hi = -1e18;
+    for (const auto& p : band) x_lo = std::min(x_lo, p.x), x_hi = std::max(x_hi, p.x);
+    const int c0 = std::max(0, static_cast<int>(std::floor(x_lo + 0.5)));
+    const int c1 = std::min(image.cols - 1, static_cast<int>(std::floor(x_hi + 0.5)));
+    float* row = image.ptr<float>(r);
+    for (int c = c0; c <= c1; ++c)
+      row[c] += value * static_cast<float>(area(clip(clip(band, 0, c - 0.5, false), 0, c + 0.5, true)));
+  }
+}
+
+// The tag-plane rectangle [x0, x1] x [y0, y1] (m) in image pixels, through the pinhole.
+Polygon project_rect(const Camera& camera, const Pose& T, double x0, double y0, double x1,
+                     double y1) {
+  Polygon out;
+  for (const auto& [x, y] : {std::pair{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}})
+    out.push_back(pinhole_pixel(camera, T * Vec3(x, y, 0)));
+  return out;
+}
+
+cv::Mat analytic_radiance(const Camera& camera, const TagFamily& family,
+                          const std::vector<RenderedTag>& tags, const ImageFormation& f) {
+  cv::Mat image(camera.height_px, camera.width_px, CV_32F, cv::Scalar(f.background));
+  const int margin = std::max(0, f.margin_cells);
+  for (const RenderedTag& tag : tags) {
+    auto cells = family.cells(tag.id);
+    if (!cells) continue;
+    const int total = cells->cols + 2 * margin;
+    const double cell_m = tag.size_m / family.cells_across_border();
+    const double h = cell_m * total / 2;
+    bool in_front = true;
+    for (double sx : {-1.0, 1.0})
+      for (double sy : {-1.0, 1.0}) in_front &= (tag.T_camera_tag * Vec3(sx * h, sy * h, 0)).z() > 1e-3;
+    if (!in_front) continue;
+    // The paper first, then each row's runs of black cells on it. (Tags must not overlap:
+    // coverage is added, not composited.)
+    add_polygon(image, project_rect(camera, tag.T_camera_tag, -h, -h, h, h),
+                static_cast<float>(f.paper - f.background));
+    for (int r = 0; r < cells->rows; ++r) {
+      const std::uint8_t* row = cells->ptr<std::uint8_t>(r);
+      for (int c = 0; c < cells->cols;) {
+        if (row[c] >= 128) { ++c; continue; }
+        int end = c;
+        while (end < cells->cols && row[end] < 128) ++end;
+        const double x0 = -h + (margin + c) * cell_m, x1 = -h + (margin + end) * cell_m;
+        const double y0 = -h + (margin + r) * cell_m;
+        add_polygon(image, project_rect(camera, tag.T_camera_tag, x0, y0, x1, y0 + cell_m),
+                    static_cast<float>(f.ink - f.paper));
+        c = end;
+      }
+    }
+  }
+  return image;
+}
+
+// Moves a pinhole image to where a lens with `distortion` puts it: each output pixel
+// reads the ideal image at its undistorted position.
+cv::Mat distort(const cv::Mat& ideal, const Camera& camera, const cv::Mat& distortion) {
+  // The map depends only on the camera and the lens, and is slow to make (every pixel
+  // undistorted iteratively): kept for the next frame of the same camera.
+  struct Cached { cv::Size size; cv::Matx33d K; cv::Mat distortion, map; };
+  thread_local Cached cache;
+  const bool same = cache.size == ideal.size() && cache.K == camera_matrix(camera) &&
+                    cache.distortion.size() == distortion.size() &&
+                    cv::norm(cache.distortion, distortion, cv::NORM_INF) == 0;
+  if (!same) {
+    std::vector<cv::Point2f> pixels;
+    pixels.reserve(static_cast<std::size_t>(ideal.total()));
+    for (int r = 0; r < ideal.rows; ++r)
+      for (int c = 0; c < ideal.cols; ++c) pixels.emplace_back(static_cast<float>(c), static_cast<float>(r));
+    std::vector<cv::Point2f> ideal_at;
+    cv::undistortPoints(pixels, ideal_at, camera_matrix(camera), distortion, cv::noArray(), camera_matrix(camera));
+    cache = {ideal.size(), camera_matrix(camera), distortion.clone(), cv::Mat(ideal.size(), CV_32FC2, ideal_at.data()).clone()};
+  }
+  cv::Mat out;
+  cv::remap(ideal, out, cache.map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  return out;
+}
+
+// A disk of `radius` px, each tap weighted by its covered area (8 x 8 sub-samples).
+cv::Mat disk_kernel(double radius) {
+  const int half = static_cast<int>(std::ceil(radius));
+  cv::Mat k(2 * half + 1, 2 * half + 1, CV_32F, cv::Scalar(0));
+  constexpr int kSub = 8;
+  for (int r = -half; r <= half; ++r)
+    for (int c = -half; c <= half; ++c) {
+      int in = 0;
+      for (int i = 0; i < kSub; ++i)
+        for (int j = 0; j < kSub; ++j) {
+          const double x = c - 0.5 + (j + 0.5) / kSub, y = r - 0.5 + (i + 0.5) / kSub;
+          in += x * x + y * y <= radius * radius;
+        }
+      k.at<float>(r + half, c + half) = static_cast<float>(in);
+    }
+  return k / cv::sum(k)[0];
+}
+
+}  // namespace
+
+double pixel_coverage(const std::vector<cv::Point2d>& poly, int x, int y) {
+  return area(clip(clip(clip(clip(poly, 1, y - 0.5, false), 1, y + 0.5, true), 0, x - 0.5, false),
+                   0, x + 0.5, true));
+}
+
+cv::Mat tag_radiance(const Camera& camera, const TagFamily& family,
+                     const std::vector<RenderedTag>& tags, const ImageFormation& f) {
+  if (f.rasteriser == Rasteriser::AnalyticArea) return analytic_radiance(camera, family, tags, f);
+  RenderLook look;
+  look.background = f.background, look.black = f.ink, look.white = f.paper;
+  look.blur_sigma_px = 0, look.supersample = f.supersample, look.margin_cells = f.margin_cells;
+  return render_tags(camera, family, tags, look);
+}
+
+cv::Mat form_image(const Camera& camera, const TagFamily& family,
+                   const std::vector<RenderedTag>& tags, const ImageFormation& f,
+                   std::mt19937_64& rng) {
+  cv::Mat linear = tag_radiance(camera, family, tags, f) * f.exposure;
+  if (!f.true_distortion.empty() && cv::countNonZero(f.true_distortion) > 0)
+    linear = distort(linear, camera, f.true_distortion);
+  if (f.gauss_blur_px > 0) cv::GaussianBlur(linear, linear, {0, 0}, f.gauss_blur_px, 0, cv::BORDER_REPLICATE);
+  if (f.defocus_radius_px > 0)
+    cv::filter2D(linear, linear, -1, disk_kernel(f.defocus_radius_px), {-1, -1}, 0, cv::BORDER_REPLICATE);
+
+  if (f.vignetting != 0) {
+    const double half_diagonal2 =
+        (camera.width_px * camera.width_px + camera.height_px * camera.height_px) / 4.0;
+    for (int r = 0; r < linear.rows; ++r) {
+      float* row = linear.ptr<float>(r);
+      const double dy2 = (r - camera.cy) * (r - camera.cy);
+      for (int c = 0; c < linear.cols; ++c)
+        row[c] *= static_cast<float>(1 - f.vignetting * ((c - camera.cx) * (c - camera.cx) + dy2) / half_diagonal2);
+    }
+  }
+  // Shot noise (variance proportional to the signal) and read noise, in linear light.
+  cv::Mat sd(linear.size(), CV_32F, cv::Scalar((f.read_noise / 255) * (f.read_noise / 255)));
+  if (f.full_well_e > 0) sd += cv::max(linear, 0) / f.full_well_e;
+  cv::sqrt(sd, sd);
+  cv::Mat noise(linear.size(), CV_32F);
+  cv::RNG cv_rng(rng());
+  cv_rng.fill(noise, cv::RNG::NORMAL, 0, 1);
+  linear += noise.mul(sd);
+  // The tone curve, then 8 bits.
+  linear = cv::min(cv::max(linear, 0), 1);
+  if (f.gamma != 1) cv::pow(linear, 1 / std::max(f.gamma, 1e-3), linear);
+  cv::Mat out;
+  linear.convertTo(out, CV_8U, 255);
+  if (f.jpeg_quality > 0) {
+    std::vector<std::uint8_t> bytes;
+    cv::imencode(".jpg", out, bytes, {cv::IMWRITE_JPEG_QUALITY, f.jpeg_quality});
+    out = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+  }
+  return out;
+}
+
+}  // namespace covtrack::fiducial
