@@ -127,6 +127,15 @@ bool scaled_square_root6(const Mat6& A, double scale, SigmaColumns& S) {
   return true;
 }
 
+// Pose 0 of a structure-of-arrays set: the unperturbed pose (rotation row-major, then translation).
+template <int Points>
+void write_unperturbed_pose(const Mat3& R, const Vec3& t, double (&pose)[12][Points]) {
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) pose[3 * i + j][0] = R(i, j);
+    pose[9 + i][0] = t[i];
+  }
+}
+
 SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut) {
   const double lambda = ut.alpha * ut.alpha * (kN + ut.kappa) - kN;
   // Above 3 degrees the default takes the symmetric root (projection.hpp says why). It and
@@ -148,10 +157,7 @@ SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut
   const Mat3 R = pose.T.linear();
   const Vec3 t = pose.T.translation();
   SigmaPoses s;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) s.pose[3 * i + j][0] = R(i, j);
-    s.pose[9 + i][0] = t[i];
-  }
+  write_unperturbed_pose(R, t, s.pose);
   exp_sigma_poses(R, t, S, s.pose);
   s.wm0 = lambda / (kN + lambda);
   s.wc0 = s.wm0 + (1 - ut.alpha * ut.alpha + ut.beta);
@@ -350,10 +356,7 @@ CubaturePoses make_cubature_poses(const UncertainPose& pose) {
   const Mat3 R = pose.T.linear();
   const Vec3 t = pose.T.translation();
   CubaturePoses c;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) c.pose[3 * i + j][0] = R(i, j);
-    c.pose[9 + i][0] = t[i];
-  }
+  write_unperturbed_pose(R, t, c.pose);
   c.w[0] = 1 + (kN * kN - 7.0 * kN) / 18;
   for (std::size_t first = 0; first < columns.size(); first += kN) {
     SigmaColumns S;
