@@ -34,6 +34,8 @@ namespace {
 const std::string kUrl = "udpm://239.255.76.67:7752?ttl=0";
 
 // A daemon with two sim sensors served as Tracker0, its log in a file.
+// The tests' ports are below 32768, outside Linux's ephemeral range (32768-60999): at 38864
+// a client socket of an earlier test here once held the port, and the daemon could not bind.
 class ServingDaemon {
  public:
   ServingDaemon(int port, int rate_hz, std::size_t max_queued_bytes = 262144, const std::string& name = "first") {
@@ -115,9 +117,9 @@ std::size_t count(const test::VrpnTestClient& c, std::int32_t sensor) {
 
 TEST(VrpnServer, ATcpClientGetsEachStreamAsItsSensorEqualToLcm) {
   HeadPoses lcm;
-  ServingDaemon daemon(38861, 100);
+  ServingDaemon daemon(28861, 100);
   test::VrpnTestClient client;
-  ASSERT_TRUE(client.connect_tcp(38861)) << daemon.log();
+  ASSERT_TRUE(client.connect_tcp(28861)) << daemon.log();
   ASSERT_TRUE(client.run_until([&] { return count(client, 0) >= 50 && count(client, 1) >= 50 && client.pongs > 0; },
                                20))
       << "sensor 0: " << count(client, 0) << ", sensor 1: " << count(client, 1) << ", pongs " << client.pongs
@@ -149,9 +151,9 @@ TEST(VrpnServer, ATcpClientGetsEachStreamAsItsSensorEqualToLcm) {
 }
 
 TEST(VrpnServer, AClientAskingOverUdpIsCalledBackAndGetsReportsOverUdp) {
-  ServingDaemon daemon(38862, 100);
+  ServingDaemon daemon(28862, 100);
   test::VrpnTestClient client;
-  ASSERT_TRUE(client.connect_by_udp_request(38862)) << "not called back\n" << daemon.log();
+  ASSERT_TRUE(client.connect_by_udp_request(28862)) << "not called back\n" << daemon.log();
   std::size_t by_udp = 0;
   ASSERT_TRUE(client.run_until(
       [&] {
@@ -167,14 +169,14 @@ TEST(VrpnServer, AClientAskingOverUdpIsCalledBackAndGetsReportsOverUdp) {
 }
 
 TEST(VrpnServer, MalformedClientsAreDroppedWithAReasonAndOthersAreServed) {
-  ServingDaemon daemon(38863, 100);
+  ServingDaemon daemon(28863, 100);
   test::VrpnTestClient good;
-  ASSERT_TRUE(good.connect_tcp(38863));
+  ASSERT_TRUE(good.connect_tcp(28863));
   ASSERT_TRUE(good.run_until([&] { return count(good, 0) >= 10; }, 20)) << daemon.log();
 
   // Not VRPN at all.
   test::VrpnTestClient http;
-  ASSERT_TRUE(http.connect_tcp(38863));
+  ASSERT_TRUE(http.connect_tcp(28863));
   const std::string request = "GET / HTTP/1.1\r\nHost: x\r\n\r\n";
   EXPECT_TRUE(http.send_raw(std::vector<std::uint8_t>(request.begin(), request.end())));
   EXPECT_TRUE(http.closed_by_server_within(10)) << daemon.log();
@@ -182,7 +184,7 @@ TEST(VrpnServer, MalformedClientsAreDroppedWithAReasonAndOthersAreServed) {
 
   // A VRPN cookie, then a header no VRPN sender writes (a length below the header).
   test::VrpnTestClient broken;
-  ASSERT_TRUE(broken.connect_tcp(38863));
+  ASSERT_TRUE(broken.connect_tcp(28863));
   const vrpn::Cookie cookie = vrpn::make_cookie();
   std::vector<std::uint8_t> bytes(cookie.begin(), cookie.end());
   for (std::uint8_t b : {0, 0, 0, 4}) bytes.push_back(b);
@@ -194,13 +196,13 @@ TEST(VrpnServer, MalformedClientsAreDroppedWithAReasonAndOthersAreServed) {
 
   // Silent: no cookie ever.
   test::VrpnTestClient silent;
-  ASSERT_TRUE(silent.connect_tcp(38863));
+  ASSERT_TRUE(silent.connect_tcp(28863));
   ASSERT_TRUE(silent.send_raw({}));
   EXPECT_TRUE(silent.closed_by_server_within(15)) << daemon.log();
   EXPECT_TRUE(daemon.log_shows("no VRPN handshake within 5 s", 5)) << daemon.log();
 
   // A datagram on the UDP port that is no connection request.
-  auto udp = vrpn::connect_udp(vrpn::ipv4_address(in_addr{htonl(INADDR_LOOPBACK)}, 38863));
+  auto udp = vrpn::connect_udp(vrpn::ipv4_address(in_addr{htonl(INADDR_LOOPBACK)}, 28863));
   ASSERT_TRUE(udp);
   ::send(udp->fd(), "\x01\x02garbage", 9, 0);
   EXPECT_TRUE(daemon.log_shows("ignored a malformed UDP connection request", 5)) << daemon.log();
@@ -213,14 +215,14 @@ TEST(VrpnServer, MalformedClientsAreDroppedWithAReasonAndOthersAreServed) {
 
 TEST(VrpnServer, AClientThatDoesNotReadIsDroppedWhilePublishingGoesOn) {
   HeadPoses lcm;
-  ServingDaemon daemon(38864, 1000, 8192);
+  ServingDaemon daemon(28864, 1000, 8192);
   test::VrpnTestClient reader;
-  ASSERT_TRUE(reader.connect_tcp(38864));
+  ASSERT_TRUE(reader.connect_tcp(28864));
   ASSERT_TRUE(reader.run_until([&] { return count(reader, 0) >= 10; }, 20)) << daemon.log();
 
   // Handshakes, then never reads again, with a small receive buffer.
   test::VrpnTestClient stalled;
-  ASSERT_TRUE(stalled.connect_tcp(38864, 10, /*receive_buffer=*/4096));
+  ASSERT_TRUE(stalled.connect_tcp(28864, 10, /*receive_buffer=*/4096));
   ASSERT_TRUE(stalled.run_until([&] { return stalled.session().ready(); }, 10));
   lcm.handle_pending();
   const std::size_t lcm_before = lcm.by_sensor["head"].size();
@@ -245,13 +247,13 @@ TEST(VrpnServer, AClientThatDoesNotReadIsDroppedWhilePublishingGoesOn) {
 }
 
 TEST(VrpnServer, APortInUseStopsTheStartWithCode1NamingTheAddress) {
-  ServingDaemon first(38865, 100);
+  ServingDaemon first(28865, 100);
   test::VrpnTestClient client;
-  ASSERT_TRUE(client.connect_tcp(38865)) << "the first daemon serves";
-  ServingDaemon second(38865, 100, 262144, "second");
+  ASSERT_TRUE(client.connect_tcp(28865)) << "the first daemon serves";
+  ServingDaemon second(28865, 100, 262144, "second");
   const auto status = second.wait(10);
   ASSERT_TRUE(status) << "the second daemon did not exit\n" << second.log();
   EXPECT_TRUE(WIFEXITED(*status) && WEXITSTATUS(*status) == 1) << "status " << *status;
-  EXPECT_NE(second.log().find("vrpn_server: cannot bind TCP 127.0.0.1:38865"), std::string::npos) << second.log();
+  EXPECT_NE(second.log().find("vrpn_server: cannot bind TCP 127.0.0.1:28865"), std::string::npos) << second.log();
   first.expect_clean_stop();
 }
