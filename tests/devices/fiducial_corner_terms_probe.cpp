@@ -11,8 +11,10 @@
 // covariance rests on).
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <map>
 #include <string>
+#include <type_traits>
 
 #include <Eigen/Eigenvalues>
 
@@ -33,6 +35,100 @@ Draws draws_of(const std::vector<TagRun>& runs, std::uint64_t first_seed) {
     out.push_back(d ? *d : std::vector<ViewDraw>{});
   }
   return out;
+}
+
+// The draws are what takes minutes; a second run with the same cache file reads them
+// back (trying model changes). The file holds this build's memory image of each field:
+// it is only valid for the binary that wrote it.
+template <typename Stream, typename T>
+void raw(Stream& s, T& value) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  if constexpr (std::is_same_v<Stream, std::ifstream>) s.read(reinterpret_cast<char*>(&value), sizeof value);
+  else s.write(reinterpret_cast<const char*>(&value), sizeof value);
+}
+template <typename Stream>
+void fields(Stream& s, ViewDraw& d) {
+  for (int i = 0; i < 16; ++i) raw(s, d.T_camera_tag_true.matrix().data()[i]);
+  bool detected = d.detection.has_value();
+  raw(s, detected);
+  if (detected) {
+    if (!d.detection) d.detection.emplace();
+    raw(s, d.detection->id), raw(s, d.detection->hamming), raw(s, d.detection->decision_margin);
+    for (auto& p : d.detection->corners_px) raw(s, p.x), raw(s, p.y);
+  }
+  raw(s, d.inputs);
+  for (auto& p : d.truth_px) raw(s, p.x), raw(s, p.y);
+}
+
+Draws cached_draws(const std::vector<TagRun>& runs, std::uint64_t first_seed, const std::string& file) {
+  if (!file.empty())
+    if (std::ifstream in(file, std::ios::binary); in) {
+      Draws out(runs.size(), std::vector<ViewDraw>(test::kDraws));
+      for (auto& view : out)
+        for (auto& d : view) fields(in, d);
+      if (in) return out;
+    }
+  Draws out = draws_of(runs, first_seed);
+  if (!file.empty()) {
+    std::ofstream f(file, std::ios::binary);
+    for (auto& view : out) {
+      view.resize(test::kDraws);
+      for (auto& d : view) fields(f, d);
+    }
+  }
+  return out;
+}
+
+// The draw-to-draw spread of each view's corner errors (about the view's mean) split into
+// the edges' line modes: the four edges' common outward move, each edge's own (the rest
+// of the outward moves) and the edges' turns; observed over what the model's independent
+// corner covariance puts in the same mode.
+void print_draw_modes(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
+  std::map<std::string, std::array<double, 6>> sums;  // observed and modelled: common, own, turn
+  for (std::size_t v = 0; v < runs.size(); ++v) {
+    std::vector<const ViewDraw*> used;
+    for (const ViewDraw& d : draws[v])
+      if (d.detection && std::isfinite(d.inputs.blur_px)) used.push_back(&d);
+    const double n = static_cast<double>(used.size());
+    if (n < 3) continue;
+    std::vector<Eigen::Matrix<double, 8, 1>> modes;
+    Eigen::Matrix<double, 8, 1> mean = Eigen::Matrix<double, 8, 1>::Zero();
+    Eigen::Matrix<double, 8, 8> modelled = Eigen::Matrix<double, 8, 8>::Zero();
+    for (const ViewDraw* d : used) {
+      const auto corrected = move_edges_in(d->detection->corners_px, m.edge_shift_px(d->inputs));
+      const Eigen::Matrix<double, 8, 8> Minv = edge_line_modes(corrected).inverse();
+      const CornerErrors e = corner_errors(m, *d);
+      Eigen::Matrix<double, 8, 1> err;
+      for (int k = 0; k < 4; ++k) err[2 * k] = e.error_px[k].x, err[2 * k + 1] = e.error_px[k].y;
+      modes.push_back(Minv * err), mean += modes.back() / n;
+      CornerNoise independent = m.noise(d->inputs);
+      independent.scale_sigma_px = independent.edge_sigma_px = independent.tilt_sigma_px = 0;
+      modelled += Minv * corner_covariance(corrected, independent) * Minv.transpose() / n;
+    }
+    Eigen::Matrix<double, 8, 8> observed = Eigen::Matrix<double, 8, 8>::Zero();
+    for (const auto& x : modes) observed += (x - mean) * (x - mean).transpose() / (n - 1);
+    Eigen::Matrix<double, 8, 8> P = Eigen::Matrix<double, 8, 8>::Zero();  // common, own x4 (rank 3), turns
+    P.topLeftCorner<4, 4>().setConstant(0.25);
+    const auto share = [](const Eigen::Matrix<double, 8, 8>& C, const Eigen::Matrix<double, 8, 8>& Q) {
+      return (Q * C * Q.transpose()).trace();
+    };
+    Eigen::Matrix<double, 8, 8> own = -P;
+    own.topLeftCorner<4, 4>() += Eigen::Matrix4d::Identity();
+    Eigen::Matrix<double, 8, 8> turns = Eigen::Matrix<double, 8, 8>::Zero();
+    turns.bottomRightCorner<4, 4>().setIdentity();
+    for (const std::string& label :
+         {std::string("all"), std::string(runs[v].view.tag.T_camera_tag.translation().z() < 1.0 ? "band 0.5-1 m" : "band 1-1.5 m")}) {
+      auto& s = sums[label];
+      s[0] += share(observed, P), s[1] += share(modelled, P);
+      s[2] += share(observed, own), s[3] += share(modelled, own);
+      s[4] += share(observed, turns), s[5] += share(modelled, turns);
+    }
+  }
+  std::printf("%s: draw-to-draw spread by edge mode, observed / modelled independent variance\n", set);
+  std::printf("  %-14s %7s %7s %7s   (modelled px^2 per view: common, own, turn)\n", "group", "common", "own", "turn");
+  for (const auto& [label, s] : sums)
+    std::printf("  %-14s %7.2f %7.2f %7.2f   %.5f %.5f %.5f\n", label.c_str(), s[0] / s[1], s[2] / s[3], s[4] / s[5],
+                s[1] / runs.size(), s[3] / runs.size(), s[5] / runs.size());
 }
 
 bool near_band(const TagRun& r) { return r.view.tag.T_camera_tag.translation().z() < 1.0; }
@@ -63,7 +159,8 @@ void add_view(Group& g, const TagRun& run, const std::vector<ViewDraw>& draws, c
     for (std::size_t k = 0; k < 4; ++k) {
       const cv::Point2d e = errors[j].error_px[k] - mean[k];
       g.indep.observed += e.dot(e) * n / (n - 1) / 2;
-      g.indep.modelled += noise.sigma_px * noise.sigma_px + noise.extra_px[k] * noise.extra_px[k];
+      g.indep.modelled += noise.sigma_px * noise.sigma_px + noise.line_sigma_px * noise.line_sigma_px +
+                          noise.extra_px[k] * noise.extra_px[k];
     }
   }
   std::array<double, 4> out{}, out_var{}, turn{}, turn_var{};
@@ -117,7 +214,7 @@ void print_terms(const char* set, const std::vector<TagRun>& runs, const Draws& 
 }
 
 void print_directions(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
-  std::map<std::string, std::array<double, 7>> sums;  // six directions and the count
+  std::map<std::string, std::array<double, 7>> sums, axes;  // six directions and the count
   for (std::size_t v = 0; v < runs.size(); ++v)
     for (const ViewDraw& d : draws[v]) {
       if (!d.detection) continue;
@@ -129,9 +226,24 @@ void print_directions(const char* set, const std::vector<TagRun>& runs, const Dr
       auto& s = sums[near_band(runs[v]) ? "band 0.5-1 m" : "band 1-1.5 m"];
       for (int i = 0; i < 6; ++i) s[i] += std::pow(eig.eigenvectors().col(i).dot(e), 2) / eig.eigenvalues()[i];
       s[6] += 1;
+      // The tag centre's position in the camera's axes (x, y across the line of sight, z
+      // along it) and the turns about the tag's own axes (x, y in its plane, z its normal).
+      Mat6 to_camera = Mat6::Identity();
+      to_camera.topLeftCorner<3, 3>() = pose->best.T_camera_tag.rotation();
+      const Vec6 ec = to_camera * e;
+      const Mat6 cc = to_camera * pose->covariance * to_camera.transpose();
+      auto& a = axes[near_band(runs[v]) ? "band 0.5-1 m" : "band 1-1.5 m"];
+      for (int i = 0; i < 6; ++i) a[i] += ec[i] * ec[i] / cc(i, i);
+      a[6] += 1;
     }
   std::printf("%s: pose NEES per principal direction, tightest first\n", set);
   for (const auto& [label, s] : sums) {
+    std::printf("  %-16s", label.c_str());
+    for (int i = 0; i < 6; ++i) std::printf(" %5.2f", s[i] / s[6]);
+    std::printf("\n");
+  }
+  std::printf("%s: NEES per axis: centre x, y, z in the camera's axes; turns about the tag's x, y, z\n", set);
+  for (const auto& [label, s] : axes) {
     std::printf("  %-16s", label.c_str());
     for (int i = 0; i < 6; ++i) std::printf(" %5.2f", s[i] / s[6]);
     std::printf("\n");
@@ -170,14 +282,23 @@ void print_halved(const char* set, const std::vector<TagRun>& runs, const Draws&
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  // Optional: a cache folder for the draws (see cached_draws).
+  const std::string cache = argc > 1 ? argv[1] : "";
   const auto calibration = test::calibration_set();
   const auto validation = test::validation_set();
-  const Draws calibration_draws = draws_of(calibration, 1);  // the test's seeds
+  const Draws calibration_draws = cached_draws(calibration, 1, cache.empty() ? "" : cache + "/calibration.bin");  // the test's seeds
   std::vector<CalibrationView> views;
   for (const auto& r : calibration) views.push_back(r.view);
   const CornerNoiseModel model = fit_corner_noise(views, calibration_draws);
-  const Draws validation_draws = draws_of(validation, 5000);
+  std::printf("calibrated: gain %.4f, floor %.4f, sample floor %.4f, aligned %.4f, shift %.4f (falloff %.2f, sigma %.4f), "
+              "scale bias %.4f/px blur, scale %.4f + %.4f/px blur, edge %.4f + %.4f/px blur, tilt %.4f + %.4f/px blur\n",
+              model.gain_px, model.floor_px, model.sample_floor_px, model.aligned_px, model.shift_px, model.shift_falloff,
+              model.shift_sigma_px, model.scale_bias_per_blur, model.scale_sigma_px, model.scale_per_blur,
+              model.edge_sigma_px, model.edge_per_blur, model.tilt_sigma_px, model.tilt_per_blur);
+  const Draws validation_draws = cached_draws(validation, 5000, cache.empty() ? "" : cache + "/validation.bin");
+  print_draw_modes("calibration", calibration, calibration_draws, model);
+  print_draw_modes("validation", validation, validation_draws, model);
   print_terms("calibration", calibration, calibration_draws, model);
   print_terms("validation", validation, validation_draws, model);
   print_directions("calibration", calibration, calibration_draws, model);

@@ -31,7 +31,8 @@ struct Residual {
   Vec8 bias_direction;    // M 1: the corners' motion when all four edges move out by 1 px
   // The shapes of the edge, scale and turn terms: M M^T, (M 1)(M 1)^T, N N^T.
   Mat8 edge_shape, scale_shape, tilt_shape;
-  Vec8 independent_var;   // the starting model's, per coordinate: image noise and floor
+  Vec8 independent_var;   // the starting model's, per coordinate: floor and pixel axes
+  Mat8 line_cov;          //   its edge-line fits' (image noise, per-sample floor)
   Vec8 shift_var;         //   and what its white-cell shift correction misses
   double scale_sd = 0, edge_sd = 0, tilt_sd = 0;  // the starting model's, at this blur
   double polarity_blur = 0;
@@ -53,6 +54,7 @@ Mat8 covariance_of(const Residual& v, const Params& p) {
   const double kI = std::exp(p[1]), kS = std::exp(p[2]), kE = std::exp(p[3]);
   const double e2 = std::pow(kE * v.edge_sd, 2), s2 = std::pow(kS * v.scale_sd, 2), t2 = std::pow(v.tilt_sd, 2);
   Mat8 S = e2 * v.edge_shape + s2 * v.scale_shape + t2 * v.tilt_shape + v.prediction;
+  S += kI * kI * v.line_cov;
   S.diagonal() += kI * kI * v.independent_var + v.shift_var;
   return S;
 }
@@ -200,6 +202,7 @@ std::vector<Residual> residuals_of(const Camera& camera, const TagBundle& board,
       v.edge_shape = out_modes * out_modes.transpose();
       v.scale_shape = v.bias_direction * v.bias_direction.transpose();
       v.tilt_shape = turn_modes * turn_modes.transpose();
+      v.line_cov = std::pow(noise.line_sigma_px, 2) * (v.edge_shape / 4 + 3 * v.tilt_shape / 4);
       v.scale_sd = model.scale_sigma(det->inputs), v.edge_sd = model.edge_sigma(det->inputs);
       v.tilt_sd = model.tilt_sigma(det->inputs);
       v.polarity_blur = det->inputs.polarity * det->inputs.blur_px;

@@ -164,6 +164,33 @@ TagAgreement agreement_of(const Camera& cam, const BundleObservation& o, const F
   return second.chi2 <= limit ? second : best;
 }
 
+// Gauss-Newton from each start, lowest starting cost first, skipping a start near a
+// minimum already found (0.01: 0.6 degrees or 1 cm, far below a flip and far above the
+// noise); the fits sorted by cost.
+std::vector<Fit> fits_from(const Camera& cam, const std::vector<TagCorners>& tags, const std::vector<Pose>& starts) {
+  std::vector<std::pair<double, Pose>> ordered;
+  for (const Pose& T : starts) ordered.emplace_back(cost_at(cam, tags, T), T);
+  std::sort(ordered.begin(), ordered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Fit> fits;
+  for (const auto& [cost, T] : ordered)
+    if (std::none_of(fits.begin(), fits.end(), [&](const Fit& f) { return boxminus(T, f.T).norm() < 0.01; }))
+      fits.push_back(gauss_newton(cam, tags, T));
+  std::sort(fits.begin(), fits.end(), [](const Fit& a, const Fit& b) { return a.cost < b.cost; });
+  return fits;
+}
+
+// Both solutions of each of these tags, mapped to the bundle.
+std::vector<Pose> tag_starts(const std::vector<BundleObservation>& observations, const std::vector<std::size_t>& which) {
+  std::vector<Pose> starts;
+  for (std::size_t i : which) {
+    const BundleObservation& o = observations[i];
+    const Pose T_tag_bundle = o.tag.T_bundle_tag.inverse();
+    starts.push_back(o.pose.best.T_camera_tag * T_tag_bundle);
+    if (o.pose.second) starts.push_back(o.pose.second->T_camera_tag * T_tag_bundle);
+  }
+  return starts;
+}
+
 std::string describe(const TagAgreement& a, double limit) {
   return fmt::format("tag {} is {:.1f} mm and {:.2f} deg from where the other tags put it (chi2 {:.1f} on 6 dof, "
                      "limit {:.1f})",
@@ -180,21 +207,10 @@ Result<BundlePose> estimate_bundle_pose(const Camera& cam, const std::vector<Bun
   if (!corners) return std::unexpected(corners.error());
   const std::vector<TagCorners>& tags = *corners;
 
-  // Starts: both solutions of every tag, mapped to the bundle, lowest cost first. A start
-  // near a minimum already found would only find it again (0.01: 0.6 degrees or 1 cm, far
-  // below a flip and far above the noise).
-  std::vector<std::pair<double, Pose>> starts;
-  for (const auto& o : observations) {
-    const Pose T_tag_bundle = o.tag.T_bundle_tag.inverse();
-    for (const auto* s : {&o.pose.best, o.pose.second ? &*o.pose.second : nullptr})
-      if (s) starts.emplace_back(cost_at(cam, tags, s->T_camera_tag * T_tag_bundle), s->T_camera_tag * T_tag_bundle);
-  }
-  std::sort(starts.begin(), starts.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<Fit> fits;
-  for (const auto& [cost, T] : starts)
-    if (std::none_of(fits.begin(), fits.end(), [&](const Fit& f) { return boxminus(T, f.T).norm() < 0.01; }))
-      fits.push_back(gauss_newton(cam, tags, T));
-  std::sort(fits.begin(), fits.end(), [](const Fit& a, const Fit& b) { return a.cost < b.cost; });
+  // Starts: both solutions of every tag.
+  std::vector<std::size_t> members(observations.size());
+  for (std::size_t i = 0; i < members.size(); ++i) members[i] = i;
+  const std::vector<Fit> fits = fits_from(cam, tags, tag_starts(observations, members));
   const Fit& best = fits.front();
   if (!std::isfinite(best.cost) || !best.covariance.allFinite())
     return fail("no bundle pose puts its tags in front of the camera");
@@ -219,9 +235,10 @@ Result<BundlePose> estimate_bundle_pose(const Camera& cam, const std::vector<Bun
   // Each tag against the others. While a strict majority of the tags in view would still
   // agree without it, the worst tag above the limit is left out and the rest refitted;
   // when none can be left out (two tags, or no majority), the covariance grows to cover
-  // the pose the others give without each disagreeing tag.
-  std::vector<std::size_t> members(observations.size());
-  for (std::size_t i = 0; i < members.size(); ++i) members[i] = i;
+  // the pose the others give without each disagreeing tag. The tags kept after one is left
+  // out are fitted anew from their own solutions as well as from the pose before: a tag
+  // far off its place can pull the fit of all into the wrong one of two minima (a
+  // board's flip), where the others alone would not be.
   Fit fit = best;
   std::vector<TagAgreement> agreement, left_out;
   std::vector<Fit> without;  // per member: the fit of the other members
@@ -241,8 +258,12 @@ Result<BundlePose> estimate_bundle_pose(const Camera& cam, const std::vector<Bun
     const bool majority_without_it = members.size() > 2 && 2 * (members.size() - 1) > observations.size();
     if (!(agreement[worst].chi2 > consistency_chi2) || !majority_without_it) break;
     left_out.push_back(agreement[worst]);
-    fit = without[worst];
     members.erase(members.begin() + static_cast<std::ptrdiff_t>(worst));
+    std::vector<TagCorners> kept;
+    for (std::size_t k : members) kept.push_back(tags[k]);
+    std::vector<Pose> starts = tag_starts(observations, members);
+    starts.push_back(without[worst].T);
+    fit = fits_from(cam, kept, starts).front();
   }
   for (const TagAgreement& a : left_out) why.push_back(fmt::format("left out {}", describe(a, consistency_chi2)));
   out.T_camera_bundle = fit.T;

@@ -49,10 +49,12 @@ EdgeShifts CornerNoiseModel::edge_shift_px(const CornerInputs& in) const {
 }
 
 double CornerNoiseModel::sigma_px(const CornerInputs& in) const {
-  return std::sqrt(floor_px * floor_px +
-                   sample_floor_px * sample_floor_px * sample_factor(in.edge_length_px) +
-                   gain_px * gain_px * noise_term(in.image_noise, in.contrast, in.edge_length_px) +
-                   aligned_px * aligned_px * in.axis_alignment);
+  return std::sqrt(floor_px * floor_px + aligned_px * aligned_px * in.axis_alignment);
+}
+
+double CornerNoiseModel::line_sigma(const CornerInputs& in) const {
+  return std::sqrt(sample_floor_px * sample_floor_px * sample_factor(in.edge_length_px) +
+                   gain_px * gain_px * noise_term(in.image_noise, in.contrast, in.edge_length_px));
 }
 
 double CornerNoiseModel::scale_sigma(const CornerInputs& in) const {
@@ -70,6 +72,7 @@ double CornerNoiseModel::tilt_sigma(const CornerInputs& in) const {
 CornerNoise CornerNoiseModel::noise(const CornerInputs& in) const {
   CornerNoise out;
   out.sigma_px = sigma_px(in);
+  out.line_sigma_px = line_sigma(in);
   out.scale_sigma_px = scale_sigma(in);
   out.edge_sigma_px = edge_sigma(in);
   out.tilt_sigma_px = tilt_sigma(in);

@@ -65,38 +65,47 @@ const TableSpec& fiducial_device_spec() {
 }
 
 std::vector<KeySpec> corner_model_keys() {
-  return {
-        {"corner_gain_px", ValueType::Float, "px", "1.1247", "corner noise model: noise/contrast gain "
+  std::vector<KeySpec> keys{
+        {"corner_gain_px", ValueType::Float, "px", "", "corner noise model: noise/contrast gain "
          "(devices/fiducial/README.md)", 0, 100},
-        {"corner_floor_px", ValueType::Float, "px", "0.0286", "corner noise model: per-camera floor "
+        {"corner_floor_px", ValueType::Float, "px", "", "corner noise model: per-camera floor "
          "for any tag size", 0, 100},
-        {"corner_sample_floor_px", ValueType::Float, "px", "0.0357", "corner noise model: per-camera "
+        {"corner_sample_floor_px", ValueType::Float, "px", "", "corner noise model: per-camera "
          "floor of each edge sample, averaged by the edge fit (shrinks as 128 / edge length above "
-         "128 px)", 0, 100},
-        {"corner_aligned_px", ValueType::Float, "px", "0.0513", "corner noise model: edges along "
+         "128 px; like the gain's term, it turns edges three times as much as it moves them)", 0, 100},
+        {"corner_aligned_px", ValueType::Float, "px", "", "corner noise model: edges along "
          "pixel axes", 0, 100},
-        {"corner_shift_px", ValueType::Float, "px", "1.6552", "corner noise model: outward shift of "
+        {"corner_shift_px", ValueType::Float, "px", "", "corner noise model: outward shift of "
          "an edge lined inside by white cells, at zero border width (corrected)", 0, 100},
-        {"corner_shift_falloff", ValueType::Float, "", "0.20", "corner noise model: that shift "
+        {"corner_shift_falloff", ValueType::Float, "", "", "corner noise model: that shift "
          "fades as exp(-falloff (border / blur)^2)", 0, 100},
-        {"corner_shift_sigma_px", ValueType::Float, "px", "1.7794", "corner noise model: what the "
+        {"corner_shift_sigma_px", ValueType::Float, "px", "", "corner noise model: what the "
          "shift correction misses, at full reach", 0, 100},
-        {"corner_scale_bias_per_blur", ValueType::Float, "", "-0.2578", "corner noise model: every "
+        {"corner_scale_bias_per_blur", ValueType::Float, "", "", "corner noise model: every "
          "edge's mean outward error per px of edge blur for a dark square (a light one: the "
          "opposite), from the camera's tone curve (removed)", -10, 10},
-        {"corner_scale_sigma_px", ValueType::Float, "px", "0.0643", "corner noise model: spread of "
+        {"corner_scale_sigma_px", ValueType::Float, "px", "", "corner noise model: spread of "
          "the four edges' common outward error (the tag's apparent size), floor", 0, 100},
-        {"corner_scale_per_blur", ValueType::Float, "", "0.1208", "corner noise model: that spread's "
+        {"corner_scale_per_blur", ValueType::Float, "", "", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},
-        {"corner_edge_sigma_px", ValueType::Float, "px", "0", "corner noise model: spread of each "
+        {"corner_edge_sigma_px", ValueType::Float, "px", "", "corner noise model: spread of each "
          "edge's own outward error, floor", 0, 100},
-        {"corner_edge_per_blur", ValueType::Float, "", "0.0282", "corner noise model: that spread's "
+        {"corner_edge_per_blur", ValueType::Float, "", "", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},
-        {"corner_tilt_sigma_px", ValueType::Float, "px", "0.0099", "corner noise model: spread of "
+        {"corner_tilt_sigma_px", ValueType::Float, "px", "", "corner noise model: spread of "
          "each edge's own turn (its ends' opposite outward errors), floor", 0, 100},
-        {"corner_tilt_per_blur", ValueType::Float, "", "0", "corner noise model: that spread's "
+        {"corner_tilt_per_blur", ValueType::Float, "", "", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},
   };
+  // The defaults are CornerNoiseModel's own (corner_noise.hpp): written in one place.
+  static const auto default_text = [] {
+    std::map<std::string_view, std::string> text;
+    const CornerNoiseModel defaults;
+    for (const CornerModelField& f : corner_model_fields()) text[f.key] = fmt::format("{:.6g}", defaults.*f.value);
+    return text;
+  }();
+  for (KeySpec& k : keys) k.default_value = default_text.at(k.key);
+  return keys;
 }
 
 const std::vector<CornerModelField>& corner_model_fields() {

@@ -104,6 +104,9 @@ Eigen::Matrix<double, 8, 8> corner_covariance(const std::array<cv::Point2d, 4>& 
   edges.topLeftCorner<4, 4>() = noise.edge_sigma_px * noise.edge_sigma_px * Eigen::Matrix4d::Identity() +
                                 noise.scale_sigma_px * noise.scale_sigma_px * Eigen::Matrix4d::Ones();
   edges.bottomRightCorner<4, 4>() = noise.tilt_sigma_px * noise.tilt_sigma_px * Eigen::Matrix4d::Identity();
+  const double line2 = noise.line_sigma_px * noise.line_sigma_px;
+  edges.topLeftCorner<4, 4>().diagonal().array() += line2 / 4;
+  edges.bottomRightCorner<4, 4>().diagonal().array() += 3 * line2 / 4;
   Eigen::Matrix<double, 8, 8> cov = M * edges * M.transpose();
   for (int i = 0; i < 8; ++i) {
     const double extra = noise.extra_px[static_cast<std::size_t>(i / 2)];
@@ -145,7 +148,8 @@ Mat6 pose_covariance(const CornerJacobian& J, const Eigen::Matrix<double, 8, 8>&
 
 Result<TagPose> estimate_tag_pose(const Camera& cam, const std::array<cv::Point2d, 4>& c,
                                   double size_m, const CornerNoise& noise, double ambiguity_chi2) {
-  const double sigma = noise.sigma_px;
+  // Per corner coordinate (the line fit's ends carry all of its variance).
+  const double sigma = std::hypot(noise.sigma_px, noise.line_sigma_px);
   for (const auto& p : c)
     if (!std::isfinite(p.x) || !std::isfinite(p.y))
       return fail("tag corner is not a finite number");

@@ -2,9 +2,10 @@
 // How well the detector places a tag corner, from what limits it (docs in
 // devices/fiducial/README.md, "Corner noise model"):
 //
-//   sigma_corner^2 = floor_px^2 + (sample_floor_px^2 + gain_px^2 * (noise / contrast)^2)
-//                    * 16 / max(16, L / 8) + aligned_px^2 * A
-//                    + shift_sigma_px^2 * (reach_a^2 + reach_b^2)
+//   per corner coordinate:  sigma^2 = floor_px^2 + aligned_px^2 * A
+//                                     + shift_sigma_px^2 * (reach_a^2 + reach_b^2)
+//   per edge end:           line^2  = (sample_floor_px^2 + gain_px^2 * (noise / contrast)^2)
+//                                     * 16 / max(16, L / 8)
 //
 // noise: the image's noise (grey levels), contrast: the grey-level step across the tag's
 // border, L: the tag's mean edge length (px). AprilTag fits each edge to max(16, L/8)
@@ -13,7 +14,10 @@
 // has an error that image noise does not explain and that differs from point to point
 // (where the edge crosses the pixel grid, the interpolation): the line averages it the
 // same way (sample_floor_px), so for tags with edges over 128 px it shrinks as 128 / L.
-// What stays for any size is floor_px.
+// A least-squares line's ends are correlated -1/2: of line^2, a quarter moves the edge's
+// line out (both ends alike) and three quarters turn it (the ends opposite), measured on
+// the draw-to-draw corner errors of both rasterisers. What stays for any size and is
+// independent per coordinate is floor_px.
 // A: how close the edges lie to the pixel axes (mean over edges of
 // exp(-(angle to the nearest axis / 3 deg)^2)). AprilTag samples the edge gradient at
 // whole pixels, so an edge along a pixel row sees the same sub-pixel phase all along and
@@ -74,20 +78,20 @@ struct CornerInputs {
 // population (tone curves gamma 1-2.4, blur 0.4-1.25 px plus defocus, JPEG 75-97 or none;
 // devices/fiducial/README.md); config/schema.md lists the same values.
 struct CornerNoiseModel {
-  double gain_px = 1.1247;
-  double floor_px = 0.0286;         // independent of the tag's size
-  double sample_floor_px = 0.0357;  // per edge sample: averaged by the edge fit (above)
-  double aligned_px = 0.0513;
+  double gain_px = 1.0742;
+  double floor_px = 0.0273;         // independent of the tag's size
+  double sample_floor_px = 0.0341;  // per edge sample: averaged by the edge fit (above)
+  double aligned_px = 0.0490;
   double shift_px = 1.6552;        // outward edge shift with all-white cells inside, zero border
   double shift_falloff = 0.20;     // how fast it fades with border / blur (see above)
-  double shift_sigma_px = 1.7794;  // the shift correction's uncertainty at reach 1
+  double shift_sigma_px = 1.6996;  // the shift correction's uncertainty at reach 1
   double scale_bias_per_blur = -0.2578;  // every edge's mean outward error per px of blur,
                                          // for a dark square (a light one: the opposite)
-  double scale_sigma_px = 0.0643;  // the four edges' common outward error: its floor
-  double scale_per_blur = 0.1208;  //   and its growth per px of edge blur
+  double scale_sigma_px = 0.0614;  // the four edges' common outward error: its floor
+  double scale_per_blur = 0.1154;  //   and its growth per px of edge blur
   double edge_sigma_px = 0.0;      // each edge's own outward error: its floor
-  double edge_per_blur = 0.0282;   //   and its growth per px of edge blur
-  double tilt_sigma_px = 0.0099;   // each edge's own turn (its ends' opposite outward
+  double edge_per_blur = 0.0269;   //   and its growth per px of edge blur
+  double tilt_sigma_px = 0.0095;   // each edge's own turn (its ends' opposite outward
   double tilt_per_blur = 0.0;      //   errors, px at each end): floor and growth per px blur
 
   // Per edge: exp(-shift_falloff (border / blur)^2).
@@ -95,8 +99,12 @@ struct CornerNoiseModel {
   // Per edge, at its start and end corner: the predicted outward shift (px),
   // shift_px * white * reach + polarity * scale_bias_per_blur * blur.
   EdgeShifts edge_shift_px(const CornerInputs& in) const;
-  // One corner coordinate's standard deviation (px) without the edge shift's term.
+  // One corner coordinate's independent standard deviation (px): the floor and the
+  // pixel-axis term (not the edge shift's, not the line fit's).
   double sigma_px(const CornerInputs& in) const;
+  // Per edge end, the line fit's standard deviation (px): the samples' errors (image noise
+  // and the per-sample floor) averaged by the fit.
+  double line_sigma(const CornerInputs& in) const;
   // The systematic edge errors' standard deviations (px) for this detection's blur.
   double scale_sigma(const CornerInputs& in) const;
   double edge_sigma(const CornerInputs& in) const;

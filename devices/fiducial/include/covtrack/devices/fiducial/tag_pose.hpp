@@ -65,6 +65,10 @@ using EdgeShifts = std::array<std::array<double, 2>, 4>;
 // What the noise model says about one tag's corners.
 struct CornerNoise {
   double sigma_px = 0.1;       // independent, per coordinate
+  // Per edge end, the error of AprilTag's least-squares line through the edge's samples:
+  // the ends of such a line are correlated -1/2, so a quarter of this variance moves the
+  // edge's line out (both ends alike) and three quarters turn it (its ends opposite).
+  double line_sigma_px = 0;
   double scale_sigma_px = 0;   // the four edges' common outward error
   double edge_sigma_px = 0;    // each edge's own outward error
   double tilt_sigma_px = 0;    // each edge's own turn: its ends' opposite outward errors
