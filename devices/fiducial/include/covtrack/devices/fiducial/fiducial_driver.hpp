@@ -6,8 +6,8 @@
 //
 // Its options (type = "fiducial"), read from the [devices.<name>] table, its
 // [[devices.<name>.tags]] tag map, its [[devices.<name>.bundles]] tag bundles and a
-// corner_calibration file. A camera has no USB ids of its own to look for: it is a V4L2
-// device whatever its maker.
+// corner_calibration file. No USB ids: a camera is any V4L2 device, whatever its maker,
+// so `covtrack devices` has none to look for.
 //
 // The options' struct is not part of this header: it holds the detector's options, the
 // corner noise model and the bundles' geometry, which are the vision code's own types
