@@ -52,8 +52,8 @@ const std::vector<DriverType>& driver_types() {
        {&fiducial::fiducial_device_spec(), &fiducial::fiducial_tag_spec(), &fiducial::fiducial_bundle_spec(),
         &fiducial::fiducial_bundle_tag_spec(), &fiducial::corner_calibration_spec()},
        [](TableReader& device, const std::string& name) -> DriverFactory {
-         fiducial::FiducialConfig config = fiducial::read_fiducial_config(device, name);
-         return [config](std::uint64_t run) { return fiducial::make_fiducial_driver(config, run); };
+         auto config = fiducial::read_fiducial_config(device, name);
+         return [config](std::uint64_t run) { return fiducial::make_fiducial_driver(*config, run); };
        }},
       {"vrpn", "a tracker served by a vrpn_server (\"Tracker0@host\"), read over TCP, republished with a "
        "covariance from config",

@@ -9,13 +9,13 @@
 #include <cstdio>
 #include <random>
 
-#include "covtrack/devices/fiducial/bundle_pose.hpp"
-#include "covtrack/devices/fiducial/corner_noise.hpp"
-#include "covtrack/devices/fiducial/lens_edge_bend.hpp"
-#include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "bundle_pose.hpp"
+#include "corner_noise.hpp"
 #include "covtrack/emulators/fiducial/tag_image_formation.hpp"
-#include "covtrack/devices/fiducial/tag_pose.hpp"
 #include "fiducial_scene.hpp"
+#include "lens_edge_bend.hpp"
+#include "tag_detector.hpp"
+#include "tag_pose.hpp"
 
 using namespace covtrack;
 using namespace covtrack::fiducial;

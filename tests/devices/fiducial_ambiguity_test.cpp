@@ -9,8 +9,8 @@
 #include <random>
 
 #include "covtrack/emulators/fiducial/noise_calibration.hpp"
-#include "covtrack/devices/fiducial/tag_pose.hpp"
 #include "fiducial_scene.hpp"
+#include "tag_pose.hpp"
 
 using namespace covtrack;
 using namespace covtrack::fiducial;

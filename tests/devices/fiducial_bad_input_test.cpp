@@ -19,10 +19,11 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "covtrack/devices/fiducial/fiducial_driver.hpp"
-#include "covtrack/devices/fiducial/raw_detection.hpp"
 #include "covtrack/emulators/fiducial/tag_renderer.hpp"
+#include "fiducial_config.hpp"
 #include "fiducial_scene.hpp"
 #include "manual_clock.hpp"
+#include "raw_detection.hpp"
 
 using namespace covtrack;
 using namespace covtrack::fiducial;

@@ -16,11 +16,11 @@
 #include <memory>
 #include <random>
 
-#include "covtrack/devices/fiducial/board_calibration.hpp"
-#include "covtrack/devices/fiducial/corner_noise.hpp"
-#include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "board_calibration.hpp"
+#include "corner_noise.hpp"
 #include "covtrack/emulators/fiducial/tag_image_formation.hpp"
 #include "fiducial_scene.hpp"
+#include "tag_detector.hpp"
 
 using namespace covtrack;
 using namespace covtrack::fiducial;

@@ -24,10 +24,10 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "covtrack/devices/fiducial/bundle_pose.hpp"
-#include "covtrack/devices/fiducial/corner_noise.hpp"
-#include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "bundle_pose.hpp"
+#include "corner_noise.hpp"
 #include "fiducial_scene.hpp"
+#include "tag_detector.hpp"
 
 using namespace covtrack;
 using namespace covtrack::fiducial;

@@ -13,10 +13,10 @@
 
 #include <Eigen/Dense>
 
-#include "covtrack/devices/fiducial/corner_noise.hpp"
-#include "covtrack/devices/fiducial/tag_detector.hpp"
-#include "covtrack/devices/fiducial/tag_pose.hpp"
+#include "corner_noise.hpp"
 #include "fiducial_scene.hpp"
+#include "tag_detector.hpp"
+#include "tag_pose.hpp"
 
 using namespace covtrack;
 using namespace covtrack::fiducial;

@@ -15,11 +15,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "covtrack/devices/fiducial/fiducial_config.hpp"
 #include "covtrack/devices/fiducial/fiducial_driver.hpp"
-#include "covtrack/devices/fiducial/raw_detection.hpp"
 #include "covtrack/emulators/fiducial/tag_renderer.hpp"
+#include "fiducial_config.hpp"
 #include "fiducial_scene.hpp"
+#include "raw_detection.hpp"
 
 using namespace covtrack;
 using namespace covtrack::fiducial;
@@ -161,7 +161,7 @@ FiducialConfig read_cam_config(const std::string& more_keys, ConfigErrors& error
     return {};
   }
   TableReader r(*toml, "devices.cam", fiducial_device_spec(), "dir/test.toml", errors);
-  return read_fiducial_config(r, "cam");
+  return *read_fiducial_config(r, "cam");
 }
 
 }  // namespace

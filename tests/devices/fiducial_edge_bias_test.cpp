@@ -6,9 +6,9 @@
 
 #include <cstdio>
 
-#include "covtrack/devices/fiducial/lens_edge_bend.hpp"
 #include "covtrack/emulators/fiducial/noise_calibration.hpp"
 #include "fiducial_scene.hpp"
+#include "lens_edge_bend.hpp"
 
 using namespace covtrack;
 using namespace covtrack::fiducial;

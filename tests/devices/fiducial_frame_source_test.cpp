@@ -14,8 +14,8 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "covtrack/devices/fiducial/frame_source.hpp"
-#include "covtrack/devices/fiducial/image_file_check.hpp"
+#include "frame_source.hpp"
+#include "image_file_check.hpp"
 
 using namespace covtrack;
 using namespace covtrack::fiducial;

@@ -11,7 +11,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "covtrack/devices/fiducial/corner_noise.hpp"
+#include "corner_noise.hpp"
 
 using covtrack::fiducial::estimate_image_noise;
 

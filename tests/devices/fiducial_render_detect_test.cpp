@@ -4,11 +4,11 @@
 
 #include <random>
 
-#include "covtrack/devices/fiducial/corner_noise.hpp"
-#include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "corner_noise.hpp"
 #include "covtrack/emulators/fiducial/tag_image_formation.hpp"
 #include "covtrack/emulators/fiducial/tag_renderer.hpp"
 #include "fiducial_scene.hpp"
+#include "tag_detector.hpp"
 
 using namespace covtrack;
 using namespace covtrack::fiducial;

@@ -18,7 +18,7 @@
 #include <gtest/gtest.h>
 
 #include "cli_support.hpp"
-#include "covtrack/devices/fiducial/fiducial_config.hpp"
+#include "fiducial_config.hpp"
 
 using namespace covtrack::testing;
 namespace fs = std::filesystem;

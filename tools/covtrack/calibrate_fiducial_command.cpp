@@ -13,11 +13,11 @@
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
+#include "board_calibration.hpp"
 #include "commands.hpp"
 #include "covtrack/program/command_line.hpp"
-#include "covtrack/devices/fiducial/board_calibration.hpp"
-#include "covtrack/devices/fiducial/fiducial_config.hpp"
-#include "covtrack/devices/fiducial/frame_source.hpp"
+#include "fiducial_config.hpp"
+#include "frame_source.hpp"
 
 namespace covtrack::cli {
 namespace {

@@ -20,9 +20,9 @@
 #include <opencv2/videoio.hpp>
 
 #include "commands.hpp"
-#include "covtrack/program/command_line.hpp"
-#include "covtrack/devices/fiducial/fiducial_config.hpp"
 #include "covtrack/emulators/fiducial/tag_image_formation.hpp"
+#include "covtrack/program/command_line.hpp"
+#include "fiducial_config.hpp"
 
 namespace covtrack::cli {
 namespace {

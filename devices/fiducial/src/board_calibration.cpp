@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/board_calibration.hpp"
+#include "board_calibration.hpp"
 
 #include <algorithm>
 #include <cmath>

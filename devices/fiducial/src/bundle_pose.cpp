@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/bundle_pose.hpp"
+#include "bundle_pose.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/corner_noise.hpp"
+#include "corner_noise.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/fiducial_config.hpp"
+#include "fiducial_config.hpp"
 
 #include <deque>
 #include <filesystem>
@@ -9,10 +9,10 @@
 #include <fmt/ranges.h>
 
 #include "covtrack/devices/device_keys.hpp"
-#include "covtrack/devices/fiducial/frame_source.hpp"
 #include "covtrack/devices/pose_keys.hpp"
 #include "covtrack/protocol/camera.hpp"
 #include "covtrack/protocol/channels.hpp"
+#include "frame_source.hpp"
 
 namespace covtrack::fiducial {
 
@@ -218,7 +218,7 @@ TagBundle read_bundle(TableReader& r, std::map<int, std::string>& owner) {
 }
 }  // namespace
 
-FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_name) {
+std::shared_ptr<const FiducialConfig> read_fiducial_config(TableReader& r, const std::string& device_name) {
   FiducialConfig c;
   c.device = device_name;
   c.parent_frame = r.string("parent_frame", "world");
@@ -287,7 +287,7 @@ FiducialConfig read_fiducial_config(TableReader& r, const std::string& device_na
       bundle_readers[i].error("name", fmt::format("'{}' is the sensor name of tag {}", tag->first, tag->second));
   if (c.tag_size_m.empty() && c.bundles.empty())
     r.error("tags", "needs at least one [[tags]] entry (id, size_m) or [[bundles]] entry");
-  return c;
+  return std::make_shared<const FiducialConfig>(std::move(c));
 }
 
 Result<CornerNoiseModel> read_corner_calibration(const std::string& file) {
@@ -322,7 +322,7 @@ Result<std::vector<FiducialConfig>> read_fiducial_devices(const std::string& con
         continue;
       const std::string device_name(name.str());
       TableReader r(*device, "devices." + device_name, fiducial_device_spec(), config_file, errors);
-      out.push_back(read_fiducial_config(r, device_name));
+      out.push_back(*read_fiducial_config(r, device_name));
     }
   if (!errors.empty()) return fail(errors.joined());
   return out;

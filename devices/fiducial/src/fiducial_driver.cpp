@@ -12,10 +12,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "covtrack/devices/fiducial/bundle_pose.hpp"
-#include "covtrack/devices/fiducial/frame_source.hpp"
-#include "covtrack/devices/fiducial/raw_detection.hpp"
-#include "covtrack/devices/fiducial/tag_pose.hpp"
+#include "bundle_pose.hpp"
+#include "fiducial_config.hpp"
+#include "frame_source.hpp"
+#include "raw_detection.hpp"
+#include "tag_pose.hpp"
 
 namespace covtrack::fiducial {
 namespace {

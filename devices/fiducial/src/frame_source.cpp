@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/frame_source.hpp"
+#include "frame_source.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/image_file_check.hpp"
+#include "image_file_check.hpp"
 
 #include <algorithm>
 #include <array>

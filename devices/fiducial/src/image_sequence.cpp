@@ -13,8 +13,8 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "covtrack/devices/fiducial/image_file_check.hpp"
 #include "covtrack/devices/file_kind.hpp"
+#include "image_file_check.hpp"
 
 namespace covtrack::fiducial {
 namespace {

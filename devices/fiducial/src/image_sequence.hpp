@@ -3,7 +3,7 @@
 #include <memory>
 #include <string>
 
-#include "covtrack/devices/fiducial/frame_source.hpp"
+#include "frame_source.hpp"
 
 namespace covtrack::fiducial {
 

@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/lens_edge_bend.hpp"
+#include "lens_edge_bend.hpp"
 
 #include <cmath>
 #include <vector>

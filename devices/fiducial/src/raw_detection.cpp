@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/raw_detection.hpp"
+#include "raw_detection.hpp"
 
 #include <cstring>
 

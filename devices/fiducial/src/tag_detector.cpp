@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "tag_detector.hpp"
 
 #include <apriltag/apriltag.h>
 #include <fmt/format.h>

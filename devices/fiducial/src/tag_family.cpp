@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/tag_family.hpp"
+#include "tag_family.hpp"
 
 #include <apriltag/apriltag.h>
 #include <apriltag/tag16h5.h>

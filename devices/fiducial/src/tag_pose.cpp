@@ -1,4 +1,4 @@
-#include "covtrack/devices/fiducial/tag_pose.hpp"
+#include "tag_pose.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 #include <opencv2/calib3d.hpp>
 
-#include "covtrack/devices/fiducial/lens_edge_bend.hpp"
+#include "lens_edge_bend.hpp"
 
 namespace covtrack::fiducial {
 namespace {

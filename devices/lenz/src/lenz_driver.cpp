@@ -10,6 +10,7 @@
 #include "covtrack/devices/serial/serial_port.hpp"
 #include "covtrack/devices/valid_frame_watchdog.hpp"
 #include "feedback_confirmation.hpp"
+#include "overloaded.hpp"
 #include "train_poses.hpp"
 #include "xpressnet_framing.hpp"
 #include "xpressnet_messages.hpp"
@@ -21,13 +22,6 @@ using Clock = DriverClock;
 using std::chrono::duration;
 using std::chrono::duration_cast;
 using std::chrono::milliseconds;
-
-template <class... F>
-struct overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-overloaded(F...) -> overloaded<F...>;  // clang before 17 deduces no aggregate's arguments
 
 // A held feedback change (feedback_confirmation.hpp) is asked for again at once; an
 // interface answers within tens of milliseconds, so one not confirmed in this long is

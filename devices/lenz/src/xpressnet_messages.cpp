@@ -2,15 +2,10 @@
 
 #include <fmt/format.h>
 
+#include "overloaded.hpp"
+
 namespace covtrack::lenz {
 namespace {
-
-template <class... F>
-struct overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-overloaded(F...) -> overloaded<F...>;  // clang before 17 deduces no aggregate's arguments
 
 std::uint8_t header(std::uint8_t opcode, std::size_t data_bytes) {
   return static_cast<std::uint8_t>(opcode | (data_bytes & 0x0F));

@@ -10,7 +10,7 @@
 #include <Eigen/Dense>
 #include <opencv2/calib3d.hpp>
 
-#include "covtrack/devices/fiducial/tag_pose.hpp"
+#include "tag_pose.hpp"
 
 namespace covtrack::fiducial {
 namespace {

@@ -3,15 +3,10 @@
 #include <algorithm>
 #include <chrono>
 
+#include "overloaded.hpp"
+
 namespace covtrack::lenz {
 namespace {
-
-template <class... F>
-struct overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-overloaded(F...) -> overloaded<F...>;  // clang before 17 deduces no aggregate's arguments
 
 constexpr std::size_t kMaxPairsPerMessage = 7;  // header nibble 14 data bytes
 

@@ -6,10 +6,10 @@
 #include <optional>
 #include <vector>
 
-#include "covtrack/devices/fiducial/corner_noise.hpp"
-#include "covtrack/devices/fiducial/tag_detector.hpp"
-#include "covtrack/devices/fiducial/tag_pose.hpp"
+#include "corner_noise.hpp"
 #include "covtrack/emulators/fiducial/tag_image_formation.hpp"
+#include "tag_detector.hpp"
+#include "tag_pose.hpp"
 
 namespace covtrack::fiducial {
 

@@ -12,9 +12,9 @@
 
 #include <opencv2/core.hpp>
 
-#include "covtrack/devices/fiducial/tag_family.hpp"
 #include "covtrack/emulators/fiducial/tag_renderer.hpp"
 #include "covtrack/protocol/camera_opencv.hpp"
+#include "tag_family.hpp"
 
 namespace covtrack::fiducial {
 

@@ -8,9 +8,9 @@
 
 #include <opencv2/core.hpp>
 
-#include "covtrack/devices/fiducial/tag_family.hpp"
 #include "covtrack/protocol/camera_opencv.hpp"
 #include "covtrack/protocol/se3.hpp"
+#include "tag_family.hpp"
 
 namespace covtrack::fiducial {
 

@@ -9,8 +9,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "covtrack/devices/fiducial/tag_family.hpp"
 #include "covtrack/protocol/result.hpp"
+#include "tag_family.hpp"
 
 struct apriltag_detector;
 

@@ -1,15 +1,18 @@
 #pragma once
 // Options of the AprilTag fiducial tracker (type = "fiducial"), read from its
 // [devices.<name>] table, its [[devices.<name>.tags]] tag map and its
-// [[devices.<name>.bundles]] tag bundles.
+// [[devices.<name>.bundles]] tag bundles (the specs and the reader are in
+// fiducial_driver.hpp), and the readers the tools use: a corner_calibration file, and
+// the fiducial devices of a whole covtrackd config.
 #include <map>
 #include <string>
 #include <vector>
 
+#include "bundle_pose.hpp"
+#include "corner_noise.hpp"
 #include "covtrack/devices/config_reader.hpp"
-#include "covtrack/devices/fiducial/bundle_pose.hpp"
-#include "covtrack/devices/fiducial/corner_noise.hpp"
-#include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "covtrack/devices/fiducial/fiducial_driver.hpp"
+#include "tag_detector.hpp"
 
 namespace covtrack::fiducial {
 
@@ -33,8 +36,6 @@ struct FiducialConfig {
   double bundle_consistency_chi2 = 40;
 };
 
-const TableSpec& fiducial_device_spec();
-const TableSpec& fiducial_tag_spec();
 // The corner noise model's keys (corner_*), in a device's table or a corner_calibration file.
 std::vector<KeySpec> corner_model_keys();
 // Each corner_* key with the model's value it sets: one list for reading and writing them.
@@ -43,14 +44,6 @@ struct CornerModelField {
   double CornerNoiseModel::*value;
 };
 const std::vector<CornerModelField>& corner_model_fields();
-// The [corner_model] table of a file written by `covtrack calibrate-fiducial`.
-const TableSpec& corner_calibration_spec();
-const TableSpec& fiducial_bundle_spec();
-const TableSpec& fiducial_bundle_tag_spec();
-
-// Relative paths are taken from the config file's folder. Problems go to the reader.
-FiducialConfig read_fiducial_config(TableReader& device, const std::string& device_name);
-
 // A corner_calibration file's model; errors name the file, line and key.
 Result<CornerNoiseModel> read_corner_calibration(const std::string& file);
 

@@ -55,8 +55,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "covtrack/devices/fiducial/tag_detector.hpp"
-#include "covtrack/devices/fiducial/tag_pose.hpp"
+#include "tag_detector.hpp"
+#include "tag_pose.hpp"
 
 namespace covtrack::fiducial {
 

@@ -24,11 +24,11 @@
 // "Per-camera calibration".
 #include <vector>
 
-#include "covtrack/devices/fiducial/bundle_pose.hpp"
-#include "covtrack/devices/fiducial/corner_noise.hpp"
-#include "covtrack/devices/fiducial/tag_detector.hpp"
+#include "bundle_pose.hpp"
+#include "corner_noise.hpp"
 #include "covtrack/protocol/camera_opencv.hpp"
 #include "covtrack/protocol/result.hpp"
+#include "tag_detector.hpp"
 
 namespace covtrack::fiducial {
 

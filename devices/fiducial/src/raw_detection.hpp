@@ -10,8 +10,8 @@
 #include <optional>
 #include <vector>
 
-#include "covtrack/devices/fiducial/tag_detector.hpp"
-#include "covtrack/devices/fiducial/tag_pose.hpp"
+#include "tag_detector.hpp"
+#include "tag_pose.hpp"
 
 namespace covtrack::fiducial {
 

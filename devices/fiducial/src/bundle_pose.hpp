@@ -32,10 +32,10 @@
 #include <string>
 #include <vector>
 
-#include "covtrack/devices/fiducial/tag_pose.hpp"
 #include "covtrack/protocol/camera_opencv.hpp"
 #include "covtrack/protocol/result.hpp"
 #include "covtrack/protocol/se3.hpp"
+#include "tag_pose.hpp"
 
 namespace covtrack::fiducial {
 
