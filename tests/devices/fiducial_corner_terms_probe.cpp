@@ -79,6 +79,50 @@ Draws cached_draws(const std::vector<TagRun>& runs, std::uint64_t first_seed, co
   return out;
 }
 
+// Each view's mean outward edge errors in the four modes of a square's edges: common
+// (the apparent size), aspect (one pair out, the other in) and the two translations
+// (one edge of a pair out, the opposite in). Mean squares over views less the means'
+// sampling variance, observed next to what the model's edge and line terms give.
+void print_view_edge_modes(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
+  std::map<std::string, std::array<double, 9>> sums;
+  for (std::size_t v = 0; v < runs.size(); ++v) {
+    std::vector<CornerErrors> errors;
+    double edge_var = 0;
+    for (const ViewDraw& d : draws[v])
+      if (d.detection && std::isfinite(d.inputs.blur_px)) {
+        errors.push_back(corner_errors(m, d));
+        edge_var += std::pow(m.edge_sigma(d.inputs), 2);
+      }
+    const double n = static_cast<double>(errors.size());
+    if (n < 3) continue;
+    edge_var /= n;
+    const auto modes = [](const std::array<double, 4>& o) {
+      return std::array<double, 4>{(o[0] + o[1] + o[2] + o[3]) / 4, (o[0] + o[2] - o[1] - o[3]) / 4, (o[0] - o[2]) / 2,
+                                   (o[1] - o[3]) / 2};
+    };
+    std::array<double, 4> mean{}, var{};
+    std::vector<std::array<double, 4>> each;
+    for (const auto& e : errors) each.push_back(modes(e.edge_out_px));
+    for (const auto& x : each)
+      for (int k = 0; k < 4; ++k) mean[k] += x[k] / n;
+    for (const auto& x : each)
+      for (int k = 0; k < 4; ++k) var[k] += std::pow(x[k] - mean[k], 2) / (n - 1);
+    for (const std::string& label : {std::string("all"), std::string(runs[v].view.tag.T_camera_tag.translation().z() < 1.0 ? "band 0.5-1 m" : "band 1-1.5 m")}) {
+      auto& s = sums[label];
+      for (int k = 0; k < 4; ++k) s[k] += mean[k] * mean[k] - var[k] / n, s[4 + k] += var[k];
+      s[8] += edge_var;
+    }
+  }
+  std::printf("%s: edge modes, mean square per view (px^2): view means (common, aspect, translations along the two\n"
+              "  pairs) | draw-to-draw (the same) | the model's edge_sigma^2 (independent edges put a quarter of it in the\n"
+              "  aspect and half in each translation)\n", set);
+  for (const auto& [label, s] : sums) {
+    std::printf("  %-14s", label.c_str());
+    for (int k = 0; k < 8; ++k) std::printf(" %.5f", s[k] / runs.size());
+    std::printf(" | %.5f\n", s[8] / runs.size());
+  }
+}
+
 // The draw-to-draw spread of each view's corner errors (about the view's mean) split into
 // the edges' line modes: the four edges' common outward move, each edge's own (the rest
 // of the outward moves) and the edges' turns; observed over what the model's independent
@@ -124,6 +168,7 @@ void print_draw_modes(const char* set, const std::vector<TagRun>& runs, const Dr
       s[4] += share(observed, turns), s[5] += share(modelled, turns);
     }
   }
+  print_view_edge_modes(set, runs, draws, m);
   std::printf("%s: draw-to-draw spread by edge mode, observed / modelled independent variance\n", set);
   std::printf("  %-14s %7s %7s %7s   (modelled px^2 per view: common, own, turn)\n", "group", "common", "own", "turn");
   for (const auto& [label, s] : sums)
