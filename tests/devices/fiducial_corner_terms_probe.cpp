@@ -1,4 +1,4 @@
-// Run by hand (about 5 min): build/tests/devices/fiducial_corner_terms_probe
+// Run by hand (about 5 min; seconds with a cache): build/tests/devices/fiducial_corner_terms_probe [CACHE_DIR]
 // How well each term of the corner noise model matches the corner errors, by the tag's
 // size in pixels and by distance band, on the held-out check's calibration set and (for
 // reporting only: nothing is fitted on it) its validation set. The model is the one the
@@ -7,8 +7,10 @@
 // draw-to-draw spread, `scale` a view's mean common outward error of the four edges,
 // `edge` each edge's own, `turn` each edge's mean turn (devices/fiducial/README.md). Then
 // the pose NEES per principal direction of the pose covariance (tightest first; 1 each
-// when right), and the pose NEES with one term's variance halved (which term the pose's
-// covariance rests on).
+// when right) and per axis, the pose NEES under the unweighted estimator's own covariance,
+// the corners' centroid against its modelled variance, the corner errors by edge mode,
+// and the pose NEES with one term's variance halved (which term the pose's covariance
+// rests on). An optional argument names a folder that caches the draws between runs.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -121,6 +123,76 @@ void print_view_edge_modes(const char* set, const std::vector<TagRun>& runs, con
     for (int k = 0; k < 8; ++k) std::printf(" %.5f", s[k] / runs.size());
     std::printf(" | %.5f\n", s[8] / runs.size());
   }
+}
+
+// The corners' centroid (where a tag's centre is seen, what its position across the line of
+// sight rests on): its error against the truth over what the model's corner covariance
+// gives it (2 when right), and each term's share of the modelled variance.
+void print_centroid(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
+  const char* names[] = {"independent", "line fit", "shift residual", "edge", "scale", "turn"};
+  std::array<double, 6> share{};
+  double nees = 0;
+  int n = 0;
+  for (std::size_t v = 0; v < runs.size(); ++v)
+    for (const ViewDraw& d : draws[v]) {
+      if (!d.detection || !std::isfinite(d.inputs.blur_px)) continue;
+      const auto corrected = move_edges_in(d.detection->corners_px, m.edge_shift_px(d.inputs));
+      const CornerErrors e = corner_errors(m, d);
+      Eigen::Vector2d c = Eigen::Vector2d::Zero();
+      for (const auto& p : e.error_px) c += Eigen::Vector2d(p.x, p.y) / 4;
+      Eigen::Matrix<double, 2, 8> P;
+      for (int k = 0; k < 4; ++k) P.block<2, 2>(0, 2 * k) = Eigen::Matrix2d::Identity() / 4;
+      const CornerNoise all = m.noise(d.inputs);
+      const Eigen::Matrix2d C = P * corner_covariance(corrected, all) * P.transpose();
+      nees += c.dot(C.ldlt().solve(c)), ++n;
+      for (int t = 0; t < 6; ++t) {
+        CornerNoise one{};
+        one.sigma_px = t == 0 ? all.sigma_px : 0;
+        one.line_sigma_px = t == 1 ? all.line_sigma_px : 0;
+        if (t == 2) one.extra_px = all.extra_px;
+        one.edge_sigma_px = t == 3 ? all.edge_sigma_px : 0;
+        one.scale_sigma_px = t == 4 ? all.scale_sigma_px : 0;
+        one.tilt_sigma_px = t == 5 ? all.tilt_sigma_px : 0;
+        share[static_cast<std::size_t>(t)] += (P * corner_covariance(corrected, one) * P.transpose()).trace() / C.trace();
+      }
+    }
+  std::printf("%s: corners' centroid NEES %.2f (2 expected) over %d draws; share of its modelled variance:", set,
+              nees / n, n);
+  for (int t = 0; t < 6; ++t) std::printf(" %s %.2f", names[t], share[static_cast<std::size_t>(t)] / n);
+  std::printf("\n");
+}
+
+// The pose is solved without weights (OpenCV's LM on the corners), while its covariance is
+// that of the estimator weighted by the corner covariance. The unweighted estimator's own
+// covariance is the sandwich (J^T J)^-1 J^T Sigma J (J^T J)^-1: the pose NEES under each.
+void print_sandwich(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
+  std::array<double, 7> weighted{}, sandwich{};
+  double total_w = 0, total_s = 0;
+  int n = 0;
+  for (std::size_t v = 0; v < runs.size(); ++v)
+    for (const ViewDraw& d : draws[v]) {
+      if (!d.detection) continue;
+      auto pose = estimate_tag_pose(runs[v].view.camera, d.detection->corners_px, runs[v].view.tag.size_m,
+                                    corner_noise(m, d));
+      if (!pose || pose->ambiguous) continue;
+      const Vec6 e = boxminus(d.T_camera_tag_true, pose->best.T_camera_tag);
+      const CornerJacobian J = corner_jacobian(runs[v].view.camera, pose->best.T_camera_tag, runs[v].view.tag.size_m);
+      const Mat6 JtJ_inv = (J.transpose() * J).inverse();
+      const Mat6 S = JtJ_inv * J.transpose() * pose->corner_covariance * J * JtJ_inv;
+      const Mat6 W = (J.transpose() * pose->corner_covariance.ldlt().solve(J)).inverse();
+      total_w += e.dot(W.ldlt().solve(e)), total_s += e.dot(S.ldlt().solve(e)), ++n;
+      const Eigen::SelfAdjointEigenSolver<Mat6> ew(W), es(S);
+      for (int i = 0; i < 6; ++i) {
+        weighted[static_cast<std::size_t>(i)] += std::pow(ew.eigenvectors().col(i).dot(e), 2) / ew.eigenvalues()[i];
+        sandwich[static_cast<std::size_t>(i)] += std::pow(es.eigenvectors().col(i).dot(e), 2) / es.eigenvalues()[i];
+      }
+    }
+  std::printf("%s: pose NEES (not ambiguous, %d draws) under the weighted estimator's covariance %.2f, per principal "
+              "direction", set, n, total_w / n);
+  for (int i = 0; i < 6; ++i) std::printf(" %.2f", weighted[static_cast<std::size_t>(i)] / n);
+  std::printf("; under the unweighted one's (sandwich) %.2f,", total_s / n);
+  for (int i = 0; i < 6; ++i) std::printf(" %.2f", sandwich[static_cast<std::size_t>(i)] / n);
+  std::printf("\n");
 }
 
 // The draw-to-draw spread of each view's corner errors (about the view's mean) split into
@@ -342,6 +414,10 @@ int main(int argc, char** argv) {
               model.shift_sigma_px, model.scale_bias_per_blur, model.scale_sigma_px, model.scale_per_blur,
               model.edge_sigma_px, model.edge_per_blur, model.tilt_sigma_px, model.tilt_per_blur);
   const Draws validation_draws = cached_draws(validation, 5000, cache.empty() ? "" : cache + "/validation.bin");
+  print_sandwich("calibration", calibration, calibration_draws, model);
+  print_sandwich("validation", validation, validation_draws, model);
+  print_centroid("calibration", calibration, calibration_draws, model);
+  print_centroid("validation", validation, validation_draws, model);
   print_draw_modes("calibration", calibration, calibration_draws, model);
   print_draw_modes("validation", validation, validation_draws, model);
   print_terms("calibration", calibration, calibration_draws, model);
