@@ -408,22 +408,14 @@ int main(int argc, char** argv) {
   std::vector<CalibrationView> views;
   for (const auto& r : calibration) views.push_back(r.view);
   const CornerNoiseModel model = fit_corner_noise(views, calibration_draws);
-  std::printf("calibrated: gain %.4f, floor %.4f, sample floor %.4f, aligned %.4f, shift %.4f (falloff %.2f, sigma %.4f), "
-              "scale bias %.4f/px blur, scale %.4f + %.4f/px blur, edge %.4f + %.4f/px blur, tilt %.4f + %.4f/px blur\n",
-              model.gain_px, model.floor_px, model.sample_floor_px, model.aligned_px, model.shift_px, model.shift_falloff,
-              model.shift_sigma_px, model.scale_bias_per_blur, model.scale_sigma_px, model.scale_per_blur,
-              model.edge_sigma_px, model.edge_per_blur, model.tilt_sigma_px, model.tilt_per_blur);
+  std::printf("calibrated: %s\n", describe(model).c_str());
   const Draws validation_draws = cached_draws(validation, 5000, cache.empty() ? "" : cache + "/validation.bin");
-  print_sandwich("calibration", calibration, calibration_draws, model);
-  print_sandwich("validation", validation, validation_draws, model);
-  print_centroid("calibration", calibration, calibration_draws, model);
-  print_centroid("validation", validation, validation_draws, model);
-  print_draw_modes("calibration", calibration, calibration_draws, model);
-  print_draw_modes("validation", validation, validation_draws, model);
-  print_terms("calibration", calibration, calibration_draws, model);
-  print_terms("validation", validation, validation_draws, model);
-  print_directions("calibration", calibration, calibration_draws, model);
-  print_directions("validation", validation, validation_draws, model);
-  print_halved("calibration", calibration, calibration_draws, model);
-  print_halved("validation", validation, validation_draws, model);
+  struct Set {
+    const char* name;
+    const std::vector<TagRun>& runs;
+    const Draws& draws;
+  };
+  const Set sets[] = {{"calibration", calibration, calibration_draws}, {"validation", validation, validation_draws}};
+  for (auto print : {print_sandwich, print_centroid, print_draw_modes, print_terms, print_directions, print_halved})
+    for (const Set& set : sets) print(set.name, set.runs, set.draws, model);
 }

@@ -80,11 +80,7 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
   EXPECT_GE(detected, static_cast<int>(calibration.size()) * kDraws * 9 / 10);
   const CornerNoiseModel model = fit_corner_noise(views, draws);
   print_views(calibration, draws, model);
-  std::printf("calibrated: gain %.4f, floor %.4f, sample floor %.4f, aligned %.4f, shift %.4f (falloff %.2f, sigma %.4f), "
-              "scale bias %.4f/px blur, scale %.4f + %.4f/px blur, edge %.4f + %.4f/px blur, tilt %.4f + %.4f/px blur\n",
-              model.gain_px, model.floor_px, model.sample_floor_px, model.aligned_px, model.shift_px, model.shift_falloff,
-              model.shift_sigma_px, model.scale_bias_per_blur, model.scale_sigma_px, model.scale_per_blur,
-              model.edge_sigma_px, model.edge_per_blur, model.tilt_sigma_px, model.tilt_per_blur);
+  std::printf("calibrated: %s\n", describe(model).c_str());
   // The shipped defaults must be this calibration's
   // result (a change that moves it must update them: corner_noise.hpp, config/schema.md).
   const CornerNoiseModel shipped;
