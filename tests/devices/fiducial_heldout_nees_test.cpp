@@ -141,7 +141,7 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
               pooled, pooled_n, 6 - half_width, 6 + half_width);
   // Not the chi-square bounds above: a view's systematic corner errors are shared by its
   // draws, so the pool holds only as many draws of them as there are views. The pooled
-  // mean measured here (4.9) is 1.2x under-confident, outside those bounds; this asserts
+  // mean measured here (4.8) is 1.26x under-confident, outside those bounds; this asserts
   // the pool within 1.3x either way, and every condition within 2x above
   // (devices/fiducial/README.md, "Limits").
   EXPECT_GT(pooled, 6 / 1.3);

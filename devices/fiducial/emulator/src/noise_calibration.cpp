@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <opencv2/calib3d.hpp>
 
+#include "lens_edge_bend.hpp"
 #include "tag_pose.hpp"
 
 namespace covtrack::fiducial {
@@ -50,8 +51,10 @@ ViewDraw one_draw(TagDetector& detector, const CalibrationView& view, std::mt199
     for (std::size_t k = 0; k < 4; ++k) worst = std::max(worst, cv::norm(det.corners_px[k] - d.truth_px[k]));
     if (worst < best) best = worst, d.detection = det;
   }
-  if (d.detection)
+  if (d.detection) {
     d.inputs = measure_corner_inputs(frame, *d.detection, detector.family(), estimate_image_noise(frame));
+    d.lens_bend_px = straight_fit_corner_offsets(camera, d.detection->corners_px);
+  }
   return d;
 }
 
@@ -87,8 +90,8 @@ CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& d) {
 CornerErrors corner_errors(const CornerNoiseModel& model, const ViewDraw& d) {
   CornerErrors out;
   if (!d.detection) return out;
-  const auto c = move_edges_in(d.detection->corners_px, model.edge_shift_px(d.inputs));
-  for (std::size_t k = 0; k < 4; ++k) out.error_px[k] = c[k] - d.truth_px[k];
+  auto c = move_edges_in(d.detection->corners_px, model.edge_shift_px(d.inputs));
+  for (std::size_t k = 0; k < 4; ++k) c[k] -= d.lens_bend_px[k], out.error_px[k] = c[k] - d.truth_px[k];
   const auto normal = edge_outward_normals(c);
   for (std::size_t e = 0; e < 4; ++e) {
     const double start = out.error_px[e].dot(normal[e]), end = out.error_px[(e + 1) % 4].dot(normal[e]);
@@ -251,7 +254,7 @@ void fit_edge_shift(CornerNoiseModel& m, const std::vector<std::vector<ViewDraw>
         for (std::size_t end = 0; end < 2; ++end) {
           const std::size_t k = (e + end) % 4;  // the edge's start or end corner
           edges.push_back({x * x, d.inputs.inner_white[e][end], d.inputs.polarity * d.inputs.blur_px,
-                           (c[k] - d.truth_px[k]).dot(normal[e])});
+                           (c[k] - d.lens_bend_px[k] - d.truth_px[k]).dot(normal[e])});
         }
       }
     }

@@ -31,9 +31,13 @@ struct ViewDraw {
   std::optional<Detection> detection;
   CornerInputs inputs;                   // measured as the driver measures them
   std::array<cv::Point2d, 4> truth_px{};  // where the four corners truly project
+  // How far AprilTag's straight fit of the lens's bent edges puts each corner, by the
+  // camera model the driver is given (straight_fit_corner_offsets): the driver removes it
+  // before the pose, so the calibration's errors leave it out as well.
+  std::array<cv::Point2d, 4> lens_bend_px{};
 };
 
-// One draw's corner errors after the model's edge-shift correction.
+// One draw's corner errors after the model's edge-shift correction and the lens bend's.
 struct CornerErrors {
   std::array<cv::Point2d, 4> error_px{};  // corrected corner - truth
   std::array<double, 4> edge_out_px{};    // per edge: its two corners' mean error along its normal
