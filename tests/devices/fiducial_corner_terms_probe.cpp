@@ -1,4 +1,4 @@
-// Run by hand (about 5 min): build/tests/devices/fiducial_corner_terms_probe
+// Run by hand (about 5 min; seconds with a cache): build/tests/devices/fiducial_corner_terms_probe [CACHE_DIR]
 // How well each term of the corner noise model matches the corner errors, by the tag's
 // size in pixels and by distance band, on the held-out check's calibration set and (for
 // reporting only: nothing is fitted on it) its validation set. The model is the one the
@@ -7,8 +7,10 @@
 // draw-to-draw spread, `scale` a view's mean common outward error of the four edges,
 // `edge` each edge's own, `turn` each edge's mean turn (devices/fiducial/README.md). Then
 // the pose NEES per principal direction of the pose covariance (tightest first; 1 each
-// when right), and the pose NEES with one term's variance halved (which term the pose's
-// covariance rests on).
+// when right) and per axis, the pose NEES under the unweighted estimator's own covariance,
+// the corners' centroid against its modelled variance, the corner errors by edge mode,
+// and the pose NEES with one term's variance halved (which term the pose's covariance
+// rests on). An optional argument names a folder that caches the draws between runs.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -79,6 +81,120 @@ Draws cached_draws(const std::vector<TagRun>& runs, std::uint64_t first_seed, co
   return out;
 }
 
+// Each view's mean outward edge errors in the four modes of a square's edges: common
+// (the apparent size), aspect (one pair out, the other in) and the two translations
+// (one edge of a pair out, the opposite in). Mean squares over views less the means'
+// sampling variance, observed next to what the model's edge and line terms give.
+void print_view_edge_modes(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
+  std::map<std::string, std::array<double, 9>> sums;
+  for (std::size_t v = 0; v < runs.size(); ++v) {
+    std::vector<CornerErrors> errors;
+    double edge_var = 0;
+    for (const ViewDraw& d : draws[v])
+      if (d.detection && std::isfinite(d.inputs.blur_px)) {
+        errors.push_back(corner_errors(m, d));
+        edge_var += std::pow(m.edge_sigma(d.inputs), 2);
+      }
+    const double n = static_cast<double>(errors.size());
+    if (n < 3) continue;
+    edge_var /= n;
+    const auto modes = [](const std::array<double, 4>& o) {
+      return std::array<double, 4>{(o[0] + o[1] + o[2] + o[3]) / 4, (o[0] + o[2] - o[1] - o[3]) / 4, (o[0] - o[2]) / 2,
+                                   (o[1] - o[3]) / 2};
+    };
+    std::array<double, 4> mean{}, var{};
+    std::vector<std::array<double, 4>> each;
+    for (const auto& e : errors) each.push_back(modes(e.edge_out_px));
+    for (const auto& x : each)
+      for (int k = 0; k < 4; ++k) mean[k] += x[k] / n;
+    for (const auto& x : each)
+      for (int k = 0; k < 4; ++k) var[k] += std::pow(x[k] - mean[k], 2) / (n - 1);
+    for (const std::string& label : {std::string("all"), std::string(runs[v].view.tag.T_camera_tag.translation().z() < 1.0 ? "band 0.5-1 m" : "band 1-1.5 m")}) {
+      auto& s = sums[label];
+      for (int k = 0; k < 4; ++k) s[k] += mean[k] * mean[k] - var[k] / n, s[4 + k] += var[k];
+      s[8] += edge_var;
+    }
+  }
+  std::printf("%s: edge modes, mean square per view (px^2): view means (common, aspect, translations along the two\n"
+              "  pairs) | draw-to-draw (the same) | the model's edge_sigma^2 (independent edges put a quarter of it in the\n"
+              "  aspect and half in each translation)\n", set);
+  for (const auto& [label, s] : sums) {
+    std::printf("  %-14s", label.c_str());
+    for (int k = 0; k < 8; ++k) std::printf(" %.5f", s[k] / runs.size());
+    std::printf(" | %.5f\n", s[8] / runs.size());
+  }
+}
+
+// The corners' centroid (where a tag's centre is seen, what its position across the line of
+// sight rests on): its error against the truth over what the model's corner covariance
+// gives it (2 when right), and each term's share of the modelled variance.
+void print_centroid(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
+  const char* names[] = {"independent", "line fit", "shift residual", "edge", "scale", "turn"};
+  std::array<double, 6> share{};
+  double nees = 0;
+  int n = 0;
+  for (std::size_t v = 0; v < runs.size(); ++v)
+    for (const ViewDraw& d : draws[v]) {
+      if (!d.detection || !std::isfinite(d.inputs.blur_px)) continue;
+      const auto corrected = move_edges_in(d.detection->corners_px, m.edge_shift_px(d.inputs));
+      const CornerErrors e = corner_errors(m, d);
+      Eigen::Vector2d c = Eigen::Vector2d::Zero();
+      for (const auto& p : e.error_px) c += Eigen::Vector2d(p.x, p.y) / 4;
+      Eigen::Matrix<double, 2, 8> P;
+      for (int k = 0; k < 4; ++k) P.block<2, 2>(0, 2 * k) = Eigen::Matrix2d::Identity() / 4;
+      const CornerNoise all = m.noise(d.inputs);
+      const Eigen::Matrix2d C = P * corner_covariance(corrected, all) * P.transpose();
+      nees += c.dot(C.ldlt().solve(c)), ++n;
+      for (int t = 0; t < 6; ++t) {
+        CornerNoise one{};
+        one.sigma_px = t == 0 ? all.sigma_px : 0;
+        one.line_sigma_px = t == 1 ? all.line_sigma_px : 0;
+        if (t == 2) one.extra_px = all.extra_px;
+        one.edge_sigma_px = t == 3 ? all.edge_sigma_px : 0;
+        one.scale_sigma_px = t == 4 ? all.scale_sigma_px : 0;
+        one.tilt_sigma_px = t == 5 ? all.tilt_sigma_px : 0;
+        share[static_cast<std::size_t>(t)] += (P * corner_covariance(corrected, one) * P.transpose()).trace() / C.trace();
+      }
+    }
+  std::printf("%s: corners' centroid NEES %.2f (2 expected) over %d draws; share of its modelled variance:", set,
+              nees / n, n);
+  for (int t = 0; t < 6; ++t) std::printf(" %s %.2f", names[t], share[static_cast<std::size_t>(t)] / n);
+  std::printf("\n");
+}
+
+// The pose is solved without weights (OpenCV's LM on the corners), while its covariance is
+// that of the estimator weighted by the corner covariance. The unweighted estimator's own
+// covariance is the sandwich (J^T J)^-1 J^T Sigma J (J^T J)^-1: the pose NEES under each.
+void print_sandwich(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
+  std::array<double, 7> weighted{}, sandwich{};
+  double total_w = 0, total_s = 0;
+  int n = 0;
+  for (std::size_t v = 0; v < runs.size(); ++v)
+    for (const ViewDraw& d : draws[v]) {
+      if (!d.detection) continue;
+      auto pose = estimate_tag_pose(runs[v].view.camera, d.detection->corners_px, runs[v].view.tag.size_m,
+                                    corner_noise(m, d));
+      if (!pose || pose->ambiguous) continue;
+      const Vec6 e = boxminus(d.T_camera_tag_true, pose->best.T_camera_tag);
+      const CornerJacobian J = corner_jacobian(runs[v].view.camera, pose->best.T_camera_tag, runs[v].view.tag.size_m);
+      const Mat6 JtJ_inv = (J.transpose() * J).inverse();
+      const Mat6 S = JtJ_inv * J.transpose() * pose->corner_covariance * J * JtJ_inv;
+      const Mat6 W = (J.transpose() * pose->corner_covariance.ldlt().solve(J)).inverse();
+      total_w += e.dot(W.ldlt().solve(e)), total_s += e.dot(S.ldlt().solve(e)), ++n;
+      const Eigen::SelfAdjointEigenSolver<Mat6> ew(W), es(S);
+      for (int i = 0; i < 6; ++i) {
+        weighted[static_cast<std::size_t>(i)] += std::pow(ew.eigenvectors().col(i).dot(e), 2) / ew.eigenvalues()[i];
+        sandwich[static_cast<std::size_t>(i)] += std::pow(es.eigenvectors().col(i).dot(e), 2) / es.eigenvalues()[i];
+      }
+    }
+  std::printf("%s: pose NEES (not ambiguous, %d draws) under the weighted estimator's covariance %.2f, per principal "
+              "direction", set, n, total_w / n);
+  for (int i = 0; i < 6; ++i) std::printf(" %.2f", weighted[static_cast<std::size_t>(i)] / n);
+  std::printf("; under the unweighted one's (sandwich) %.2f,", total_s / n);
+  for (int i = 0; i < 6; ++i) std::printf(" %.2f", sandwich[static_cast<std::size_t>(i)] / n);
+  std::printf("\n");
+}
+
 // The draw-to-draw spread of each view's corner errors (about the view's mean) split into
 // the edges' line modes: the four edges' common outward move, each edge's own (the rest
 // of the outward moves) and the edges' turns; observed over what the model's independent
@@ -124,6 +240,7 @@ void print_draw_modes(const char* set, const std::vector<TagRun>& runs, const Dr
       s[4] += share(observed, turns), s[5] += share(modelled, turns);
     }
   }
+  print_view_edge_modes(set, runs, draws, m);
   std::printf("%s: draw-to-draw spread by edge mode, observed / modelled independent variance\n", set);
   std::printf("  %-14s %7s %7s %7s   (modelled px^2 per view: common, own, turn)\n", "group", "common", "own", "turn");
   for (const auto& [label, s] : sums)
@@ -291,18 +408,14 @@ int main(int argc, char** argv) {
   std::vector<CalibrationView> views;
   for (const auto& r : calibration) views.push_back(r.view);
   const CornerNoiseModel model = fit_corner_noise(views, calibration_draws);
-  std::printf("calibrated: gain %.4f, floor %.4f, sample floor %.4f, aligned %.4f, shift %.4f (falloff %.2f, sigma %.4f), "
-              "scale bias %.4f/px blur, scale %.4f + %.4f/px blur, edge %.4f + %.4f/px blur, tilt %.4f + %.4f/px blur\n",
-              model.gain_px, model.floor_px, model.sample_floor_px, model.aligned_px, model.shift_px, model.shift_falloff,
-              model.shift_sigma_px, model.scale_bias_per_blur, model.scale_sigma_px, model.scale_per_blur,
-              model.edge_sigma_px, model.edge_per_blur, model.tilt_sigma_px, model.tilt_per_blur);
+  std::printf("calibrated: %s\n", describe(model).c_str());
   const Draws validation_draws = cached_draws(validation, 5000, cache.empty() ? "" : cache + "/validation.bin");
-  print_draw_modes("calibration", calibration, calibration_draws, model);
-  print_draw_modes("validation", validation, validation_draws, model);
-  print_terms("calibration", calibration, calibration_draws, model);
-  print_terms("validation", validation, validation_draws, model);
-  print_directions("calibration", calibration, calibration_draws, model);
-  print_directions("validation", validation, validation_draws, model);
-  print_halved("calibration", calibration, calibration_draws, model);
-  print_halved("validation", validation, validation_draws, model);
+  struct Set {
+    const char* name;
+    const std::vector<TagRun>& runs;
+    const Draws& draws;
+  };
+  const Set sets[] = {{"calibration", calibration, calibration_draws}, {"validation", validation, validation_draws}};
+  for (auto print : {print_sandwich, print_centroid, print_draw_modes, print_terms, print_directions, print_halved})
+    for (const Set& set : sets) print(set.name, set.runs, set.draws, model);
 }

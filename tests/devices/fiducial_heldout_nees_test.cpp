@@ -80,11 +80,7 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
   EXPECT_GE(detected, static_cast<int>(calibration.size()) * kDraws * 9 / 10);
   const CornerNoiseModel model = fit_corner_noise(views, draws);
   print_views(calibration, draws, model);
-  std::printf("calibrated: gain %.4f, floor %.4f, sample floor %.4f, aligned %.4f, shift %.4f (falloff %.2f, sigma %.4f), "
-              "scale bias %.4f/px blur, scale %.4f + %.4f/px blur, edge %.4f + %.4f/px blur, tilt %.4f + %.4f/px blur\n",
-              model.gain_px, model.floor_px, model.sample_floor_px, model.aligned_px, model.shift_px, model.shift_falloff,
-              model.shift_sigma_px, model.scale_bias_per_blur, model.scale_sigma_px, model.scale_per_blur,
-              model.edge_sigma_px, model.edge_per_blur, model.tilt_sigma_px, model.tilt_per_blur);
+  std::printf("calibrated: %s\n", describe(model).c_str());
   // The shipped defaults must be this calibration's
   // result (a change that moves it must update them: corner_noise.hpp, config/schema.md).
   const CornerNoiseModel shipped;
@@ -145,7 +141,7 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
               pooled, pooled_n, 6 - half_width, 6 + half_width);
   // Not the chi-square bounds above: a view's systematic corner errors are shared by its
   // draws, so the pool holds only as many draws of them as there are views. The pooled
-  // mean measured here (5.0) is 1.2x under-confident, outside those bounds; this asserts
+  // mean measured here (4.9) is 1.2x under-confident, outside those bounds; this asserts
   // the pool within 1.3x either way, and every condition within 2x above
   // (devices/fiducial/README.md, "Limits").
   EXPECT_GT(pooled, 6 / 1.3);

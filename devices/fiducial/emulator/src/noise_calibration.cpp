@@ -8,6 +8,7 @@
 #include <utility>
 
 #include <Eigen/Dense>
+#include <fmt/format.h>
 #include <opencv2/calib3d.hpp>
 
 #include "tag_pose.hpp"
@@ -94,6 +95,15 @@ CornerErrors corner_errors(const CornerNoiseModel& model, const ViewDraw& d) {
     out.edge_out_px[e] = (start + end) / 2, out.edge_turn_px[e] = (start - end) / 2;
   }
   return out;
+}
+
+std::string describe(const CornerNoiseModel& m) {
+  return fmt::format("gain {:.4f}, floor {:.4f}, sample floor {:.4f}, aligned {:.4f}, shift {:.4f} (falloff {:.2f}, "
+                     "sigma {:.4f}), scale bias {:.4f}/px blur, scale {:.4f} + {:.4f}/px blur, edge {:.4f} + {:.4f}/px "
+                     "blur, tilt {:.4f} + {:.4f}/px blur",
+                     m.gain_px, m.floor_px, m.sample_floor_px, m.aligned_px, m.shift_px, m.shift_falloff,
+                     m.shift_sigma_px, m.scale_bias_per_blur, m.scale_sigma_px, m.scale_per_blur, m.edge_sigma_px,
+                     m.edge_per_blur, m.tilt_sigma_px, m.tilt_per_blur);
 }
 
 double mean_pose_nees(const CalibrationView& view,

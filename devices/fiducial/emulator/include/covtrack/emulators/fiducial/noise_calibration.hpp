@@ -4,6 +4,7 @@
 // which calibrates on one set of views and validates on another).
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "corner_noise.hpp"
@@ -63,6 +64,9 @@ CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& draw);
 //     draws is 6.
 CornerNoiseModel fit_corner_noise(const std::vector<CalibrationView>& views,
                                   const std::vector<std::vector<ViewDraw>>& draws);
+
+// The coefficients on one line, as the calibration reports them.
+std::string describe(const CornerNoiseModel& model);
 
 // Mean pose NEES of the detected draws of one view under `model`; `count` gets how many.
 double mean_pose_nees(const CalibrationView& view,
