@@ -360,15 +360,39 @@ Result<QueryResult> TransformGraph::query_locked(FrameIndex a, FrameIndex b, std
   const std::vector<FrameIndex>& path_A = path->up_A;  // child frames, A upwards
   const std::vector<FrameIndex>& path_B = path->up_B;
 
+  // The usual query passes no fused frame: every edge on it is its own error and is met
+  // once, so its value goes straight into the chain, without the map of evaluated edges a
+  // fused frame's paths need (ArView makes one query per object and frame).
+  const auto fused = [&](FrameIndex c) { return !frames_[c].edge.via.empty(); };
+  if (mode == Propagation::LowestCommonAncestor && std::none_of(path_A.begin(), path_A.end(), fused) &&
+      std::none_of(path_B.begin(), path_B.end(), fused)) {
+    QueryResult out;
+    std::vector<ChainFactor> factors(path_A.size() + path_B.size());
+    // Evaluated A upwards, then B upwards (the order of the combiner choices); chained from
+    // A up to the LCA and down to B.
+    for (std::size_t k = 0; k < factors.size(); ++k) {
+      const bool up = k < path_A.size();
+      const FrameIndex child = up ? path_A[k] : path_B[k - path_A.size()];
+      auto v = edge_value(child, now_us);
+      if (!v) return std::unexpected(v.error());
+      if (v->choice) out.combiner_choices.push_back(*v->choice);
+      out.pose.unbounded = out.pose.unbounded || v->value.unbounded;
+      factors[up ? k : factors.size() - 1 - (k - path_A.size())] = {v->value.T, v->value.covariance, up};
+    }
+    const UncertainPose p = compose_chain(factors);
+    out.pose.T = p.T;
+    out.pose.covariance = p.covariance;
+    if (out.pose.unbounded) out.pose.covariance.setZero();
+    return out;
+  }
+
   QueryResult out;
   QueryState state;
   state.now_us = now_us;
-  bool through_fused = false;
   for (const auto* part : {&path_A, &path_B})
     for (const auto& child : *part) {
       if (auto r = evaluate_edge(child, state); !r) return std::unexpected(r.error());
       out.pose.unbounded = out.pose.unbounded || state.edges.at(child).value.unbounded;
-      through_fused = through_fused || !frames_[child].edge.via.empty();
     }
   out.combiner_choices = std::move(state.choices);
   auto value = [&](FrameIndex c) -> const UncertainPose& { return state.edges.at(c).value; };
@@ -383,21 +407,12 @@ Result<QueryResult> TransformGraph::query_locked(FrameIndex a, FrameIndex b, std
   };
 
   switch (mode) {
-    case Propagation::LowestCommonAncestor: {
-      if (through_fused) {  // its paths may share edges with this one
-        const fusion::LinearEstimate l = state.along(*path);
-        const Mat6 c = fusion::covariance(l, state.covariance_of());
-        out.pose.T = l.T;
-        out.pose.covariance = 0.5 * (c + c.transpose());
-        break;
-      }
-      std::vector<ChainFactor> factors;
-      for (const auto& c : path_A) factors.push_back({value(c).T, value(c).covariance, true});
-      for (auto it = path_B.rbegin(); it != path_B.rend(); ++it)
-        factors.push_back({value(*it).T, value(*it).covariance, false});
-      const UncertainPose p = compose_chain(factors);
-      out.pose.T = p.T;
-      out.pose.covariance = p.covariance;
+    case Propagation::LowestCommonAncestor: {  // through a fused frame (the rest is above)
+      // Its paths may share edges with this one.
+      const fusion::LinearEstimate l = state.along(*path);
+      const Mat6 c = fusion::covariance(l, state.covariance_of());
+      out.pose.T = l.T;
+      out.pose.covariance = 0.5 * (c + c.transpose());
       break;
     }
     case Propagation::OsgarRoot: {
