@@ -31,13 +31,27 @@ bool label_listed(const ArObject& o, int level) {
 }
 }  // namespace
 
+Result<UncertainPose> ArView::query(const TransformGraph& graph, std::size_t object, std::int64_t time_us) {
+  // Names are looked up once per graph (a key names its graph); a frame the graph does not
+  // have yet is looked up again each frame, and queried by name so that the error is the
+  // graph's own.
+  const auto keyed = [&](std::optional<TransformGraph::FrameKey>& key, const std::string& frame) {
+    if (!key || key->graph != graph.id()) key = graph.key(frame);
+    return key.has_value();
+  };
+  if (keyed(camera_key_, camera_frame_) && keyed(frame_keys_[object], objects_[object].frame))
+    return graph.query(*camera_key_, *frame_keys_[object], time_us);
+  return graph.query(camera_frame_, objects_[object].frame, time_us);
+}
+
 Result<void> ArView::update(const TransformGraph& graph, std::int64_t time_us) {
   const std::size_t n = objects_.size();
   next_.time_us = time_us;
+  frame_keys_.resize(n);
   next_.objects.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const ArObject& o = objects_[i];
-    auto T = graph.query(camera_frame_, o.frame, time_us);
+    auto T = query(graph, i, time_us);
     if (!T) return fail("object " + o.name + ": " + T.error().message);
     ArObjectFrame& f = next_.objects[i];
     f.T_camera_object = *T;
@@ -58,10 +72,10 @@ Result<void> ArView::update(const TransformGraph& graph, std::int64_t time_us) {
       std::swap(r.outer, f.regions.outer);
     }
   }
-  const std::vector<PlacedLabel> placed = place_labels(requests_, options_.labels);
+  placer_.place(requests_, options_.labels, labels_);
   for (std::size_t i = 0; i < n; ++i) {
     ArObjectFrame& f = next_.objects[i];
-    f.label = placed[i];
+    f.label = labels_[i];
     if (!label_listed(objects_[i], f.level)) {
       std::swap(requests_[i].inner, f.regions.inner);
       std::swap(requests_[i].outer, f.regions.outer);

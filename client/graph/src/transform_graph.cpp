@@ -1,6 +1,7 @@
 #include "covtrack/client/transform_graph.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <unordered_set>
 
 #include "covtrack/client/graph_chain.hpp"
@@ -9,7 +10,29 @@
 
 namespace covtrack::client {
 
-TransformGraph::TransformGraph(Propagation mode) : mode_(mode) {}
+namespace {
+std::uint64_t next_graph_id() {
+  static std::atomic<std::uint64_t> last{0};
+  return ++last;
+}
+}  // namespace
+
+TransformGraph::TransformGraph(Propagation mode) : id_(next_graph_id()), mode_(mode) {}
+
+std::optional<TransformGraph::FrameKey> TransformGraph::key(const std::string& frame) const {
+  std::lock_guard lock(mutex_);
+  const auto index = find(frame);
+  if (!index) return std::nullopt;
+  return FrameKey{id_, *index};
+}
+
+Result<UncertainPose> TransformGraph::query(FrameKey A, FrameKey B, std::int64_t now_us) const {
+  std::lock_guard lock(mutex_);
+  if (A.graph != id_ || B.graph != id_) return fail("transform graph: a frame key from another graph");
+  auto r = query_locked(A.index, B.index, now_us, mode_);
+  if (!r) return std::unexpected(r.error());
+  return r->pose;
+}
 
 void TransformGraph::set_propagation(Propagation mode) {
   std::lock_guard lock(mutex_);
@@ -241,8 +264,14 @@ struct TransformGraph::QueryState {
 std::optional<TransformGraph::TreePath> TransformGraph::tree_path(FrameIndex A, FrameIndex B) const {
   const auto up_A = ancestry(A);
   const auto up_B = ancestry(B);
-  const std::unordered_set<FrameIndex> set_A(up_A.begin(), up_A.end());
-  const auto lca = std::find_if(up_B.begin(), up_B.end(), [&](FrameIndex f) { return set_A.contains(f); });
+  // The lowest of B's ancestors that is one of A's. A short ancestry (the usual scene) is
+  // searched as it is; a hash set would cost more than it saves.
+  constexpr std::size_t kShort = 16;
+  std::unordered_set<FrameIndex> set_A;
+  if (up_A.size() > kShort) set_A.insert(up_A.begin(), up_A.end());
+  const auto lca = std::find_if(up_B.begin(), up_B.end(), [&](FrameIndex f) {
+    return up_A.size() > kShort ? set_A.contains(f) : std::find(up_A.begin(), up_A.end(), f) != up_A.end();
+  });
   if (lca == up_B.end()) return std::nullopt;
   return TreePath{{up_A.begin(), std::find(up_A.begin(), up_A.end(), *lca)}, {up_B.begin(), lca}};
 }
@@ -311,11 +340,19 @@ Result<void> TransformGraph::evaluate_fused(FrameIndex child, QueryState& state)
 Result<QueryResult> TransformGraph::query_detailed(const std::string& A, const std::string& B,
                                                    std::int64_t now_us, Propagation mode) const {
   std::lock_guard lock(mutex_);  // one lock for the whole query: consistent edges
-  for (const auto* f : {&A, &B})
-    if (!index_.contains(*f)) return fail("transform graph: unknown frame '" + *f + "'");
-  const FrameIndex a = *find(A), b = *find(B);
+  const auto a = find(A);
+  if (!a) return fail("transform graph: unknown frame '" + A + "'");
+  const auto b = find(B);
+  if (!b) return fail("transform graph: unknown frame '" + B + "'");
+  return query_locked(*a, *b, now_us, mode);
+}
+
+Result<QueryResult> TransformGraph::query_locked(FrameIndex a, FrameIndex b, std::int64_t now_us,
+                                                 Propagation mode) const {
   auto path = tree_path(a, b);
-  if (!path) return fail("transform graph: frames '" + A + "' and '" + B + "' are in different trees");
+  if (!path)
+    return fail("transform graph: frames '" + frames_[a].name + "' and '" + frames_[b].name +
+                "' are in different trees");
   if (mode != Propagation::LowestCommonAncestor) {  // both whole root paths
     const auto up_A = ancestry(a), up_B = ancestry(b);
     path = TreePath{{up_A.begin(), up_A.end() - 1}, {up_B.begin(), up_B.end() - 1}};
@@ -323,15 +360,39 @@ Result<QueryResult> TransformGraph::query_detailed(const std::string& A, const s
   const std::vector<FrameIndex>& path_A = path->up_A;  // child frames, A upwards
   const std::vector<FrameIndex>& path_B = path->up_B;
 
+  // The usual query passes no fused frame: every edge on it is its own error and is met
+  // once, so its value goes straight into the chain, without the map of evaluated edges a
+  // fused frame's paths need (ArView makes one query per object and frame).
+  const auto fused = [&](FrameIndex c) { return !frames_[c].edge.via.empty(); };
+  if (mode == Propagation::LowestCommonAncestor && std::none_of(path_A.begin(), path_A.end(), fused) &&
+      std::none_of(path_B.begin(), path_B.end(), fused)) {
+    QueryResult out;
+    std::vector<ChainFactor> factors(path_A.size() + path_B.size());
+    // Evaluated A upwards, then B upwards (the order of the combiner choices); chained from
+    // A up to the LCA and down to B.
+    for (std::size_t k = 0; k < factors.size(); ++k) {
+      const bool up = k < path_A.size();
+      const FrameIndex child = up ? path_A[k] : path_B[k - path_A.size()];
+      auto v = edge_value(child, now_us);
+      if (!v) return std::unexpected(v.error());
+      if (v->choice) out.combiner_choices.push_back(*v->choice);
+      out.pose.unbounded = out.pose.unbounded || v->value.unbounded;
+      factors[up ? k : factors.size() - 1 - (k - path_A.size())] = {v->value.T, v->value.covariance, up};
+    }
+    const UncertainPose p = compose_chain(factors);
+    out.pose.T = p.T;
+    out.pose.covariance = p.covariance;
+    if (out.pose.unbounded) out.pose.covariance.setZero();
+    return out;
+  }
+
   QueryResult out;
   QueryState state;
   state.now_us = now_us;
-  bool through_fused = false;
   for (const auto* part : {&path_A, &path_B})
     for (const auto& child : *part) {
       if (auto r = evaluate_edge(child, state); !r) return std::unexpected(r.error());
       out.pose.unbounded = out.pose.unbounded || state.edges.at(child).value.unbounded;
-      through_fused = through_fused || !frames_[child].edge.via.empty();
     }
   out.combiner_choices = std::move(state.choices);
   auto value = [&](FrameIndex c) -> const UncertainPose& { return state.edges.at(c).value; };
@@ -346,21 +407,12 @@ Result<QueryResult> TransformGraph::query_detailed(const std::string& A, const s
   };
 
   switch (mode) {
-    case Propagation::LowestCommonAncestor: {
-      if (through_fused) {  // its paths may share edges with this one
-        const fusion::LinearEstimate l = state.along(*path);
-        const Mat6 c = fusion::covariance(l, state.covariance_of());
-        out.pose.T = l.T;
-        out.pose.covariance = 0.5 * (c + c.transpose());
-        break;
-      }
-      std::vector<ChainFactor> factors;
-      for (const auto& c : path_A) factors.push_back({value(c).T, value(c).covariance, true});
-      for (auto it = path_B.rbegin(); it != path_B.rend(); ++it)
-        factors.push_back({value(*it).T, value(*it).covariance, false});
-      const UncertainPose p = compose_chain(factors);
-      out.pose.T = p.T;
-      out.pose.covariance = p.covariance;
+    case Propagation::LowestCommonAncestor: {  // through a fused frame (the rest is above)
+      // Its paths may share edges with this one.
+      const fusion::LinearEstimate l = state.along(*path);
+      const Mat6 c = fusion::covariance(l, state.covariance_of());
+      out.pose.T = l.T;
+      out.pose.covariance = 0.5 * (c + c.transpose());
       break;
     }
     case Propagation::OsgarRoot: {

@@ -28,20 +28,21 @@ Vec2 sane_size(const Vec2& size) {
           std::isfinite(size.y()) ? std::max(size.y(), 0.0) : 0.0};
 }
 
+// The centres of feasible_label_centers, for a region known to be usable.
+Polygon centers_within(const Polygon& region, const Vec2& size, const Box& screen);
+
 std::optional<Box> place_inside(const Polygon& inner, const Vec2& size, const Box& screen,
                                 const BoxGrid& placed) {
-  const Polygon centers = feasible_label_centers(inner, size, screen);
+  const Polygon centers = centers_within(inner, size, screen);
   if (centers.empty()) return std::nullopt;
   // The middle of the feasible centres first (the label sits well inside), then its
   // corners, which move the label as far as it can go when another label is in the way.
-  std::vector<Vec2> tries = {polygon_centroid(centers)};
-  tries.insert(tries.end(), centers.begin(), centers.end());
-  for (const Vec2& c : tries) {
-    const Box box = box_at_center(c, size);
-    if (box_inside_convex(box, inner) && box_inside(box, screen, kInsideTolerancePx) &&
-        clear_of(box, placed))
-      return box;
-  }
+  const auto fits = [&](const Box& box) {
+    return box_inside_convex(box, inner) && box_inside(box, screen, kInsideTolerancePx) && clear_of(box, placed);
+  };
+  if (const Box box = box_at_center(polygon_centroid(centers), size); fits(box)) return box;
+  for (const Vec2& c : centers)
+    if (const Box box = box_at_center(c, size); fits(box)) return box;
   return std::nullopt;
 }
 
@@ -49,6 +50,11 @@ std::optional<Box> place_inside(const Polygon& inner, const Vec2& size, const Bo
 struct Obstacles {
   std::vector<const Polygon*> regions;
   BoxGrid bounds;
+};
+
+// Polygon i of a request, usable or not, told once per call: the checks read every vertex.
+struct Usable {
+  bool inner = false, outer = false;
 };
 
 std::optional<Box> place_outside(const Polygon& outer, const Vec2& size, const LabelPlacerOptions& o,
@@ -83,6 +89,11 @@ std::array<Vec2, 2> leader_to(const Box& box, const Polygon& region) {
 
 Polygon feasible_label_centers(const Polygon& region, const Vec2& size, const Box& screen) {
   if (!is_usable_polygon(region)) return {};
+  return centers_within(region, size, screen);
+}
+
+namespace {
+Polygon centers_within(const Polygon& region, const Vec2& size, const Box& screen) {
   const Vec2 half = 0.5 * size;
   Polygon centers = region;
   for (std::size_t i = 0, n = region.size(); i < n && !centers.empty(); ++i) {
@@ -103,56 +114,81 @@ Polygon feasible_label_centers(const Polygon& region, const Vec2& size, const Bo
     if (!centers.empty()) centers = clip_half_plane(centers, normal, offset);
   return centers;
 }
+}  // namespace
 
-std::vector<PlacedLabel> place_labels(std::span<const LabelRequest> requests,
-                                      const LabelPlacerOptions& o) {
+struct LabelPlacer::Workspace {
+  BoxGrid placed;
+  Obstacles objects;
+  std::vector<Usable> usable;
+  std::vector<std::size_t> rest;
+  std::vector<Vec2> sizes;
+};
+
+LabelPlacer::LabelPlacer() : work_(std::make_unique<Workspace>()) {}
+LabelPlacer::~LabelPlacer() = default;
+LabelPlacer::LabelPlacer(LabelPlacer&&) noexcept = default;
+LabelPlacer& LabelPlacer::operator=(LabelPlacer&&) noexcept = default;
+
+void LabelPlacer::place(std::span<const LabelRequest> requests, const LabelPlacerOptions& o,
+                        std::vector<PlacedLabel>& labels) {
+  Workspace& w = *work_;
   const std::size_t n = requests.size();
-  std::vector<PlacedLabel> labels(n);
-  std::vector<bool> done(n, false);
+  labels.assign(n, PlacedLabel{});
+  w.usable.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    w.usable[i] = {is_usable_polygon(requests[i].inner), is_usable_polygon(requests[i].outer)};
   // Cells about the size of a label when the screen is full of objects.
   const int cells = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(n))), 1, 64);
-  BoxGrid placed(o.screen, cells);
+  BoxGrid& placed = w.placed;
+  placed.reset(o.screen, cells);
+  // A label is placed when it is anchored (inside or outside); the rest go to the list.
   // Inside labels first: they are the most constrained, and an outside label must not
   // take the space an inner region offers.
   if (o.allow_inside) {
     for (std::size_t i = 0; i < n; ++i) {
-      if (!is_usable_polygon(requests[i].inner)) continue;
+      if (!w.usable[i].inner) continue;
       const Vec2 size = sane_size(requests[i].size_px);
       if (auto box = place_inside(requests[i].inner, size, o.screen, placed)) {
         labels[i] = {*box, LabelPlacement::inside_inner, true, std::nullopt, true};
         placed.insert(*box);
-        done[i] = true;
       }
     }
   }
-  Obstacles objects{{}, BoxGrid(o.screen, cells)};
+  Obstacles& objects = w.objects;
+  objects.regions.clear();
+  objects.bounds.reset(o.screen, cells);
   if (o.avoid_other_objects)
-    for (const LabelRequest& r : requests)
-      if (is_usable_polygon(r.outer)) objects.regions.push_back(&r.outer), objects.bounds.insert(bounding_box(r.outer));
+    for (std::size_t i = 0; i < n; ++i)
+      if (w.usable[i].outer)
+        objects.regions.push_back(&requests[i].outer), objects.bounds.insert(bounding_box(requests[i].outer));
   for (std::size_t i = 0; i < n; ++i) {
-    if (done[i] || !is_usable_polygon(requests[i].outer)) continue;
+    if (labels[i].anchored || !w.usable[i].outer) continue;
     const Vec2 size = sane_size(requests[i].size_px);
     if (auto box = place_outside(requests[i].outer, size, o, placed, objects)) {
       labels[i] = {*box, LabelPlacement::outside_outer, true, leader_to(*box, requests[i].outer),
                    true};
       placed.insert(*box);
-      done[i] = true;
     }
   }
-  std::vector<std::size_t> rest;
-  std::vector<Vec2> sizes;
+  w.rest.clear();
+  w.sizes.clear();
   for (std::size_t i = 0; i < n; ++i)
-    if (!done[i]) rest.push_back(i), sizes.push_back(sane_size(requests[i].size_px));
-  const std::vector<Box> list = stack_in_corner(sizes, placed.boxes(), o.screen, o.gap_px);
-  for (std::size_t k = 0; k < rest.size(); ++k) {
-    PlacedLabel& label = labels[rest[k]];
+    if (!labels[i].anchored) w.rest.push_back(i), w.sizes.push_back(sane_size(requests[i].size_px));
+  const std::vector<Box> list = stack_in_corner(w.sizes, placed.boxes(), o.screen, o.gap_px);
+  for (std::size_t k = 0; k < w.rest.size(); ++k) {
+    PlacedLabel& label = labels[w.rest[k]];
     label.box = list[k];
     label.placement = LabelPlacement::corner_list;
     label.anchored = false;
-    if (is_usable_polygon(requests[rest[k]].outer))
-      label.leader = leader_to(list[k], requests[rest[k]].outer);
+    if (w.usable[w.rest[k]].outer) label.leader = leader_to(list[k], requests[w.rest[k]].outer);
     label.on_screen = box_inside(list[k], o.screen);
   }
+}
+
+std::vector<PlacedLabel> place_labels(std::span<const LabelRequest> requests,
+                                      const LabelPlacerOptions& o) {
+  std::vector<PlacedLabel> labels;
+  LabelPlacer().place(requests, o, labels);
   return labels;
 }
 

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,7 @@ class ArView {
   const std::vector<ArObject>& objects() const { return objects_; }
 
  private:
+  Result<UncertainPose> query(const TransformGraph& graph, std::size_t object, std::int64_t time_us);
   ArView(Camera camera, std::string camera_frame, std::vector<ArObject> objects,
          std::vector<LevelOfError> levels, ArViewOptions options);
 
@@ -77,6 +79,11 @@ class ArView {
   ArViewOptions options_;
   ArFrame frame_, next_;  // the frame handed out, and the one being computed
   std::vector<LabelRequest> requests_;
+  // Each object's frame and the camera's, looked up in the graph last updated from.
+  std::optional<TransformGraph::FrameKey> camera_key_;
+  std::vector<std::optional<TransformGraph::FrameKey>> frame_keys_;
+  LabelPlacer placer_;  // its memory, and that of the buffers around it, lasts across frames
+  std::vector<PlacedLabel> labels_;
 };
 
 }  // namespace covtrack::client

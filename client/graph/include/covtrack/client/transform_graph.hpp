@@ -135,6 +135,19 @@ class TransformGraph {
   Result<QueryResult> query_detailed(const std::string& A, const std::string& B,
                                      std::int64_t now_us, Propagation mode) const;
 
+  // A frame's name looked up once, for a caller that queries the same frames every frame
+  // (ArView: 1,000 objects, two name look-ups each per frame otherwise). Frames are never
+  // removed, so a key stays good as long as the graph that gave it.
+  struct FrameKey {
+    std::uint64_t graph = 0;  // which graph gave it (every graph has its own number)
+    std::size_t index = 0;
+  };
+  std::optional<FrameKey> key(const std::string& frame) const;
+  std::uint64_t id() const { return id_; }  // the number its keys carry
+  // query(A, B, now_us) by keys, in the graph's propagation mode: the same result. Fails
+  // for a key another graph gave.
+  Result<UncertainPose> query(FrameKey A, FrameKey B, std::int64_t now_us) const;
+
   bool has_frame(const std::string& frame) const;
   void set_propagation(Propagation mode);
 
@@ -175,6 +188,9 @@ class TransformGraph {
     std::vector<FrameIndex> up_A, up_B;
   };
   std::optional<TreePath> tree_path(FrameIndex A, FrameIndex B) const;
+  Result<QueryResult> query_locked(FrameIndex A, FrameIndex B, std::int64_t now_us, Propagation mode) const;
+
+  const std::uint64_t id_;  // FrameKey::graph
 
   mutable std::mutex mutex_;
   Propagation mode_;

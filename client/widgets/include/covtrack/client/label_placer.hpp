@@ -12,6 +12,7 @@
 // only a list that outgrows the screen leaves it.
 #include <array>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -62,6 +63,25 @@ struct LabelPlacerOptions {
 // One label per request, same order.
 std::vector<PlacedLabel> place_labels(std::span<const LabelRequest> requests,
                                       const LabelPlacerOptions& options = {});
+
+// place_labels for a caller that places labels every frame (ArView): it keeps its working
+// memory (the grids of placed labels and of objects) from one call to the next, so that
+// it allocates next to nothing once the number of labels settles. Same labels.
+class LabelPlacer {
+ public:
+  LabelPlacer();
+  ~LabelPlacer();
+  LabelPlacer(LabelPlacer&&) noexcept;
+  LabelPlacer& operator=(LabelPlacer&&) noexcept;
+
+  // Writes one label per request into `labels` (resized), same order.
+  void place(std::span<const LabelRequest> requests, const LabelPlacerOptions& options,
+             std::vector<PlacedLabel>& labels);
+
+ private:
+  struct Workspace;  // label_placer.cpp
+  std::unique_ptr<Workspace> work_;
+};
 
 // Centres at which a box of `size` lies inside the convex `region` and inside `screen`:
 // the region clipped by each edge moved inwards by the box's extent along its normal.
