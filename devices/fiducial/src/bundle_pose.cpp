@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -209,7 +210,7 @@ Result<BundlePose> estimate_bundle_pose(const Camera& cam, const std::vector<Bun
 
   // Starts: both solutions of every tag.
   std::vector<std::size_t> members(observations.size());
-  for (std::size_t i = 0; i < members.size(); ++i) members[i] = i;
+  std::iota(members.begin(), members.end(), std::size_t{0});
   const std::vector<Fit> fits = fits_from(cam, tags, tag_starts(observations, members));
   const Fit& best = fits.front();
   if (!std::isfinite(best.cost) || !best.covariance.allFinite())
