@@ -67,10 +67,9 @@ TransformGraph::FrameIndex TransformGraph::tree_of(FrameIndex frame) {
   return frame;
 }
 
-std::vector<TransformGraph::FrameIndex> TransformGraph::ancestry(FrameIndex frame) const {
-  std::vector<FrameIndex> out{frame};
+void TransformGraph::ancestry(FrameIndex frame, std::vector<FrameIndex>& out) const {
+  out.assign(1, frame);
   for (auto p = frames_[frame].parent; p; p = frames_[*p].parent) out.push_back(*p);
-  return out;
 }
 
 Result<void> TransformGraph::add_edge(const std::string& parent, const std::string& child, Edge edge) {
@@ -261,9 +260,11 @@ struct TransformGraph::QueryState {
   }
 };
 
-std::optional<TransformGraph::TreePath> TransformGraph::tree_path(FrameIndex A, FrameIndex B) const {
-  const auto up_A = ancestry(A);
-  const auto up_B = ancestry(B);
+bool TransformGraph::tree_path(FrameIndex A, FrameIndex B, TreePath& path) const {
+  std::vector<FrameIndex>& up_A = path.up_A;
+  std::vector<FrameIndex>& up_B = path.up_B;
+  ancestry(A, up_A);
+  ancestry(B, up_B);
   // The lowest of B's ancestors that is one of A's. A short ancestry (the usual scene) is
   // searched as it is; a hash set would cost more than it saves.
   constexpr std::size_t kShort = 16;
@@ -272,8 +273,10 @@ std::optional<TransformGraph::TreePath> TransformGraph::tree_path(FrameIndex A, 
   const auto lca = std::find_if(up_B.begin(), up_B.end(), [&](FrameIndex f) {
     return up_A.size() > kShort ? set_A.contains(f) : std::find(up_A.begin(), up_A.end(), f) != up_A.end();
   });
-  if (lca == up_B.end()) return std::nullopt;
-  return TreePath{{up_A.begin(), std::find(up_A.begin(), up_A.end(), *lca)}, {up_B.begin(), lca}};
+  if (lca == up_B.end()) return false;
+  up_A.erase(std::find(up_A.begin(), up_A.end(), *lca), up_A.end());
+  up_B.erase(lca, up_B.end());
+  return true;
 }
 
 Result<void> TransformGraph::evaluate_edge(FrameIndex child, QueryState& state) const {
@@ -292,7 +295,8 @@ Result<void> TransformGraph::evaluate_fused(FrameIndex child, QueryState& state)
   std::vector<fusion::LinearEstimate> paths;
   std::vector<UncertainPose> candidates;
   for (FrameIndex v : via) {
-    const TreePath path = *tree_path(*frame.parent, v);  // one tree: checked when added
+    TreePath path;
+    tree_path(*frame.parent, v, path);  // one tree: checked when added
     bool unbounded = false;
     for (const auto* part : {&path.up_A, &path.up_B})
       for (FrameIndex c : *part) {
@@ -349,16 +353,18 @@ Result<QueryResult> TransformGraph::query_detailed(const std::string& A, const s
 
 Result<QueryResult> TransformGraph::query_locked(FrameIndex a, FrameIndex b, std::int64_t now_us,
                                                  Propagation mode) const {
-  auto path = tree_path(a, b);
-  if (!path)
+  TreePath& path = buffers_.path;
+  if (!tree_path(a, b, path))
     return fail("transform graph: frames '" + frames_[a].name + "' and '" + frames_[b].name +
                 "' are in different trees");
   if (mode != Propagation::LowestCommonAncestor) {  // both whole root paths
-    const auto up_A = ancestry(a), up_B = ancestry(b);
-    path = TreePath{{up_A.begin(), up_A.end() - 1}, {up_B.begin(), up_B.end() - 1}};
+    ancestry(a, path.up_A);
+    ancestry(b, path.up_B);
+    path.up_A.pop_back();
+    path.up_B.pop_back();
   }
-  const std::vector<FrameIndex>& path_A = path->up_A;  // child frames, A upwards
-  const std::vector<FrameIndex>& path_B = path->up_B;
+  const std::vector<FrameIndex>& path_A = path.up_A;  // child frames, A upwards
+  const std::vector<FrameIndex>& path_B = path.up_B;
 
   // The usual query passes no fused frame: every edge on it is its own error and is met
   // once, so its value goes straight into the chain, without the map of evaluated edges a
@@ -367,7 +373,8 @@ Result<QueryResult> TransformGraph::query_locked(FrameIndex a, FrameIndex b, std
   if (mode == Propagation::LowestCommonAncestor && std::none_of(path_A.begin(), path_A.end(), fused) &&
       std::none_of(path_B.begin(), path_B.end(), fused)) {
     QueryResult out;
-    std::vector<ChainFactor> factors(path_A.size() + path_B.size());
+    std::vector<ChainFactor>& factors = buffers_.factors;
+    factors.resize(path_A.size() + path_B.size());
     // Evaluated A upwards, then B upwards (the order of the combiner choices); chained from
     // A up to the LCA and down to B.
     for (std::size_t k = 0; k < factors.size(); ++k) {
@@ -409,7 +416,7 @@ Result<QueryResult> TransformGraph::query_locked(FrameIndex a, FrameIndex b, std
   switch (mode) {
     case Propagation::LowestCommonAncestor: {  // through a fused frame (the rest is above)
       // Its paths may share edges with this one.
-      const fusion::LinearEstimate l = state.along(*path);
+      const fusion::LinearEstimate l = state.along(path);
       const Mat6 c = fusion::covariance(l, state.covariance_of());
       out.pose.T = l.T;
       out.pose.covariance = 0.5 * (c + c.transpose());

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "covtrack/client/combiner.hpp"
+#include "covtrack/client/graph_chain.hpp"
 #include "covtrack/client/graph_staleness.hpp"
 #include "covtrack/client/tracked_transform.hpp"
 #include "covtrack/client/uncertain_pose.hpp"
@@ -177,7 +178,7 @@ class TransformGraph {
   std::optional<FrameIndex> find(const std::string& frame) const;
   FrameIndex add_frame(const std::string& frame);  // a new root
   FrameIndex tree_of(FrameIndex frame);
-  std::vector<FrameIndex> ancestry(FrameIndex frame) const;  // frame, ..., root
+  void ancestry(FrameIndex frame, std::vector<FrameIndex>& out) const;  // frame, ..., root
   UncertainPose source_value(const EdgeSource& source, std::int64_t now_us) const;
   Result<EdgeValue> edge_value(FrameIndex child, std::int64_t now_us) const;
   // Each evaluates into `state` (once per query) and fails only on a combiner's error.
@@ -187,7 +188,8 @@ class TransformGraph {
   struct TreePath {
     std::vector<FrameIndex> up_A, up_B;
   };
-  std::optional<TreePath> tree_path(FrameIndex A, FrameIndex B) const;
+  // Into `path`, keeping its memory; false when A and B are in different trees.
+  bool tree_path(FrameIndex A, FrameIndex B, TreePath& path) const;
   Result<QueryResult> query_locked(FrameIndex A, FrameIndex B, std::int64_t now_us, Propagation mode) const;
 
   const std::uint64_t id_;  // FrameKey::graph
@@ -203,6 +205,13 @@ class TransformGraph {
   // StreamId::key() of every stream an edge is bound to -> that edge's parent frame.
   std::unordered_map<std::string, std::string> bound_streams_;
   std::map<std::string, TrackedTransform> latest_;         // by StreamId::key()
+  // A query's path and chain, kept from one query to the next (under mutex_): ArView
+  // queries every object every frame, and these were its allocations.
+  struct QueryBuffers {
+    TreePath path;
+    std::vector<ChainFactor> factors;
+  };
+  mutable QueryBuffers buffers_;
 };
 
 }  // namespace covtrack::client
