@@ -12,11 +12,6 @@ Box box_at_center(const Vec2& center_px, const Vec2& size_px) {
 
 Box box_at_corner(const Vec2& min_px, const Vec2& size_px) { return {min_px, min_px + size_px}; }
 
-bool box_inside(const Box& inner, const Box& outer, double tol) {
-  return inner.min.x() >= outer.min.x() - tol && inner.min.y() >= outer.min.y() - tol &&
-         inner.max.x() <= outer.max.x() + tol && inner.max.y() <= outer.max.y() + tol;
-}
-
 Polygon box_polygon(const Box& b) {
   return {b.min, Vec2(b.max.x(), b.min.y()), b.max, Vec2(b.min.x(), b.max.y())};
 }

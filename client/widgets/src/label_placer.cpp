@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "box_cover.hpp"
 #include "box_grid.hpp"
 #include "covtrack/client/convex_polygon.hpp"
 #include "covtrack/client/space_manager.hpp"
@@ -19,26 +20,44 @@ bool box_inside_convex(const Box& box, const Polygon& convex) {
   return true;
 }
 
-bool clear_of(const Box& box, const BoxGrid& placed) {
-  return !placed.any_near(box, [&](std::size_t i) { return boxes_overlap(box, placed.boxes()[i]); });
-}
+// The labels placed so far: filed in a grid for the exact test, and in a raster that
+// rejects most overlapping candidates with one box test (box_cover.hpp).
+struct PlacedBoxes {
+  BoxGrid grid;
+  BoxCover cover;
+
+  void reset(const Box& screen, int cells) {
+    grid.reset(screen, cells);
+    cover.reset(screen);
+  }
+  void insert(const Box& box) {
+    cover.insert(box);
+    grid.insert(box);
+  }
+  bool clear_of(const Box& box) const {
+    if (cover.overlap_at_corners(box)) return false;
+    return !grid.any_near(box, [&](std::size_t i) { return boxes_overlap(box, grid.boxes()[i]); });
+  }
+};
 
 Vec2 sane_size(const Vec2& size) {
   return {std::isfinite(size.x()) ? std::max(size.x(), 0.0) : 0.0,
           std::isfinite(size.y()) ? std::max(size.y(), 0.0) : 0.0};
 }
 
-// The centres of feasible_label_centers, for a region known to be usable.
-Polygon centers_within(const Polygon& region, const Vec2& size, const Box& screen);
+// The centres of feasible_label_centers, for a region known to be usable, into `centers`
+// (`scratch` holds the clipping's steps): no allocation per label once they have grown.
+void centers_within(const Polygon& region, const Vec2& size, const Box& screen, Polygon& centers,
+                    Polygon& scratch);
 
 std::optional<Box> place_inside(const Polygon& inner, const Vec2& size, const Box& screen,
-                                const BoxGrid& placed) {
-  const Polygon centers = centers_within(inner, size, screen);
+                                const PlacedBoxes& placed, Polygon& centers, Polygon& scratch) {
+  centers_within(inner, size, screen, centers, scratch);
   if (centers.empty()) return std::nullopt;
   // The middle of the feasible centres first (the label sits well inside), then its
   // corners, which move the label as far as it can go when another label is in the way.
   const auto fits = [&](const Box& box) {
-    return box_inside_convex(box, inner) && box_inside(box, screen, kInsideTolerancePx) && clear_of(box, placed);
+    return box_inside_convex(box, inner) && box_inside(box, screen, kInsideTolerancePx) && placed.clear_of(box);
   };
   if (const Box box = box_at_center(polygon_centroid(centers), size); fits(box)) return box;
   for (const Vec2& c : centers)
@@ -57,10 +76,11 @@ struct Usable {
   bool inner = false, outer = false;
 };
 
-std::optional<Box> place_outside(const Polygon& outer, const Vec2& size, const LabelPlacerOptions& o,
-                                 const BoxGrid& placed, const Obstacles& objects) {
+std::optional<Box> place_outside(const Polygon& outer, const Box& outer_bounds, const Vec2& size,
+                                 const LabelPlacerOptions& o, const PlacedBoxes& placed,
+                                 const Obstacles& objects) {
   if (!o.policy) return std::nullopt;
-  const std::vector<Box> candidates = o.policy(bounding_box(outer), size, o.screen, o.gap_px);
+  const std::vector<Box> candidates = o.policy(outer_bounds, size, o.screen, o.gap_px);
   const auto hides_another = [&](const Box& box) {
     return o.avoid_other_objects && objects.bounds.any_near(box, [&](std::size_t k) {
       return objects.regions[k] != &outer && boxes_overlap(box, objects.bounds.boxes()[k]) &&
@@ -72,7 +92,7 @@ std::optional<Box> place_outside(const Polygon& outer, const Vec2& size, const L
   std::optional<Box> fallback;
   for (const Box& box : candidates) {
     if (!(box.min.allFinite() && box.max.allFinite() && box_inside(box, o.screen) &&
-          clear_of(box, placed) && !box_meets_convex(box, outer)))
+          placed.clear_of(box) && !box_meets_convex(box, outer)))
       continue;
     if (!hides_another(box)) return box;
     if (!fallback) fallback = box;
@@ -89,20 +109,29 @@ std::array<Vec2, 2> leader_to(const Box& box, const Polygon& region) {
 
 Polygon feasible_label_centers(const Polygon& region, const Vec2& size, const Box& screen) {
   if (!is_usable_polygon(region)) return {};
-  return centers_within(region, size, screen);
+  Polygon centers, scratch;
+  centers_within(region, size, screen, centers, scratch);
+  return centers;
 }
 
 namespace {
-Polygon centers_within(const Polygon& region, const Vec2& size, const Box& screen) {
+void centers_within(const Polygon& region, const Vec2& size, const Box& screen, Polygon& centers,
+                    Polygon& scratch) {
   const Vec2 half = 0.5 * size;
-  Polygon centers = region;
+  // Each clip writes at most two points per edge (one for a convex region).
+  const auto clip = [&](const Vec2& normal, double offset) {
+    scratch.resize(2 * centers.size());
+    scratch.resize(clip_half_plane(centers, normal, offset, scratch.data()));
+    centers.swap(scratch);
+  };
+  centers.assign(region.begin(), region.end());
   for (std::size_t i = 0, n = region.size(); i < n && !centers.empty(); ++i) {
     const Vec2 e = region[(i + 1) % n] - region[i];
     if (e.squaredNorm() == 0) continue;
     const Vec2 outward = Vec2(e.y(), -e.x()).normalized();
     // The box corner farthest along the outward normal must stay behind the edge.
     const double reach = std::abs(outward.x()) * half.x() + std::abs(outward.y()) * half.y();
-    centers = clip_half_plane(centers, outward, outward.dot(region[i]) - reach);
+    clip(outward, outward.dot(region[i]) - reach);
   }
   const std::array<std::pair<Vec2, double>, 4> screen_sides = {{
       {Vec2(-1, 0), -(screen.min.x() + half.x())},
@@ -111,15 +140,16 @@ Polygon centers_within(const Polygon& region, const Vec2& size, const Box& scree
       {Vec2(0, 1), screen.max.y() - half.y()},
   }};
   for (const auto& [normal, offset] : screen_sides)
-    if (!centers.empty()) centers = clip_half_plane(centers, normal, offset);
-  return centers;
+    if (!centers.empty()) clip(normal, offset);
 }
 }  // namespace
 
 struct LabelPlacer::Workspace {
-  BoxGrid placed;
+  PlacedBoxes placed;
   Obstacles objects;
   std::vector<Usable> usable;
+  std::vector<Box> outer_bounds;  // of the usable outer regions
+  Polygon centers, scratch;
   std::vector<std::size_t> rest;
   std::vector<Vec2> sizes;
 };
@@ -135,11 +165,14 @@ void LabelPlacer::place(std::span<const LabelRequest> requests, const LabelPlace
   const std::size_t n = requests.size();
   labels.assign(n, PlacedLabel{});
   w.usable.resize(n);
-  for (std::size_t i = 0; i < n; ++i)
+  w.outer_bounds.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
     w.usable[i] = {is_usable_polygon(requests[i].inner), is_usable_polygon(requests[i].outer)};
+    if (w.usable[i].outer) w.outer_bounds[i] = bounding_box(requests[i].outer);
+  }
   // Cells about the size of a label when the screen is full of objects.
   const int cells = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(n))), 1, 64);
-  BoxGrid& placed = w.placed;
+  PlacedBoxes& placed = w.placed;
   placed.reset(o.screen, cells);
   // A label is placed when it is anchored (inside or outside); the rest go to the list.
   // Inside labels first: they are the most constrained, and an outside label must not
@@ -148,7 +181,7 @@ void LabelPlacer::place(std::span<const LabelRequest> requests, const LabelPlace
     for (std::size_t i = 0; i < n; ++i) {
       if (!w.usable[i].inner) continue;
       const Vec2 size = sane_size(requests[i].size_px);
-      if (auto box = place_inside(requests[i].inner, size, o.screen, placed)) {
+      if (auto box = place_inside(requests[i].inner, size, o.screen, placed, w.centers, w.scratch)) {
         labels[i] = {*box, LabelPlacement::inside_inner, true, std::nullopt, true};
         placed.insert(*box);
       }
@@ -160,11 +193,11 @@ void LabelPlacer::place(std::span<const LabelRequest> requests, const LabelPlace
   if (o.avoid_other_objects)
     for (std::size_t i = 0; i < n; ++i)
       if (w.usable[i].outer)
-        objects.regions.push_back(&requests[i].outer), objects.bounds.insert(bounding_box(requests[i].outer));
+        objects.regions.push_back(&requests[i].outer), objects.bounds.insert(w.outer_bounds[i]);
   for (std::size_t i = 0; i < n; ++i) {
     if (labels[i].anchored || !w.usable[i].outer) continue;
     const Vec2 size = sane_size(requests[i].size_px);
-    if (auto box = place_outside(requests[i].outer, size, o, placed, objects)) {
+    if (auto box = place_outside(requests[i].outer, w.outer_bounds[i], size, o, placed, objects)) {
       labels[i] = {*box, LabelPlacement::outside_outer, true, leader_to(*box, requests[i].outer),
                    true};
       placed.insert(*box);
@@ -174,7 +207,7 @@ void LabelPlacer::place(std::span<const LabelRequest> requests, const LabelPlace
   w.sizes.clear();
   for (std::size_t i = 0; i < n; ++i)
     if (!labels[i].anchored) w.rest.push_back(i), w.sizes.push_back(sane_size(requests[i].size_px));
-  const std::vector<Box> list = stack_in_corner(w.sizes, placed.boxes(), o.screen, o.gap_px);
+  const std::vector<Box> list = stack_in_corner(w.sizes, placed.grid.boxes(), o.screen, o.gap_px);
   for (std::size_t k = 0; k < w.rest.size(); ++k) {
     PlacedLabel& label = labels[w.rest[k]];
     label.box = list[k];

@@ -30,6 +30,7 @@ void append_side(Side side, const Box& o, const Vec2& s, double gap, std::vector
 
 std::vector<Box> candidates(std::span<const Side> sides, const Box& o, const Vec2& s, double gap) {
   std::vector<Box> out;
+  out.reserve(sides.size() * (2 * kSlidesEachWay + 1));  // one allocation per label, not six
   for (Side side : sides) append_side(side, o, s, gap, out);
   return out;
 }

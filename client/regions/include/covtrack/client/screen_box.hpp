@@ -22,8 +22,12 @@ Box box_at_corner(const Vec2& min_px, const Vec2& size_px);
 inline bool boxes_overlap(const Box& a, const Box& b) {
   return a.min.x() < b.max.x() && b.min.x() < a.max.x() && a.min.y() < b.max.y() && b.min.y() < a.max.y();
 }
-// `inner` lies within `outer` (within tolerance_px).
-bool box_inside(const Box& inner, const Box& outer, double tolerance_px = 1e-9);
+// `inner` lies within `outer` (within tolerance_px). Inline: the label placer asks it of
+// every candidate place.
+inline bool box_inside(const Box& inner, const Box& outer, double tolerance_px = 1e-9) {
+  return inner.min.x() >= outer.min.x() - tolerance_px && inner.min.y() >= outer.min.y() - tolerance_px &&
+         inner.max.x() <= outer.max.x() + tolerance_px && inner.max.y() <= outer.max.y() + tolerance_px;
+}
 // The box as a counter-clockwise polygon.
 Polygon box_polygon(const Box& box);
 // The interiors of the box and of a convex polygon meet (separating-axis test).
