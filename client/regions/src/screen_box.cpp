@@ -28,36 +28,77 @@ void project(const Points& points, const Vec2& axis, double& lo, double& hi) {
   }
 }
 
-bool separates(const std::array<Vec2, 4>& corners, const Polygon& convex, const Vec2& axis) {
-  double a_lo, a_hi, b_lo, b_hi;
+using Corners = std::array<Vec2, 4>;
+
+Corners corners_of(const Box& box) {
+  return {box.min, Vec2(box.max.x(), box.min.y()), box.max, Vec2(box.min.x(), box.max.y())};
+}
+
+// The polygon's extent [b_lo, b_hi] on `axis` separates the corners'.
+bool separates(const Corners& corners, const Vec2& axis, double b_lo, double b_hi) {
+  double a_lo, a_hi;
   project(corners, axis, a_lo, a_hi);
-  project(convex, axis, b_lo, b_hi);
   // Touching (within rounding of the coordinates) counts as separated.
   const double tol = 1e-9 * (1 + std::abs(a_lo) + std::abs(b_hi));
   return a_hi <= b_lo + tol || b_hi <= a_lo + tol;
+}
+
+// On its own outward edge normal the polygon reaches no further than the edge itself,
+// so each edge is one O(1) test: the box wholly beyond the edge's line.
+bool beyond_edge(const Corners& corners, const Vec2& outward, double edge) {
+  double box_lo = outward.dot(corners[0]);
+  for (const Vec2& c : corners) box_lo = std::min(box_lo, outward.dot(c));
+  return box_lo >= edge - 1e-9 * (1 + std::abs(edge));
+}
+
+// Calls side(outward, offset) for each edge of non-zero length until one returns true.
+template <class Side>
+bool any_side(const Polygon& convex, Side&& side) {
+  for (std::size_t i = 0, n = convex.size(); i < n; ++i) {
+    const Vec2 e = convex[(i + 1) % n] - convex[i];
+    if (e.squaredNorm() == 0) continue;
+    const Vec2 outward = Vec2(e.y(), -e.x()).normalized();
+    if (side(outward, outward.dot(convex[i]))) return true;
+  }
+  return false;
 }
 }  // namespace
 
 bool box_meets_convex(const Box& box, const Polygon& convex) {
   if (convex.size() < 3) return false;
   // Called for every candidate label position: no allocation here.
-  const std::array<Vec2, 4> corners = {box.min, Vec2(box.max.x(), box.min.y()), box.max,
-                                       Vec2(box.min.x(), box.max.y())};
+  const Corners corners = corners_of(box);
   // Two convex sets have disjoint interiors iff some edge normal of one separates them;
   // the box's normals are the two coordinate axes.
-  if (separates(corners, convex, Vec2(1, 0)) || separates(corners, convex, Vec2(0, 1)))
-    return false;
-  // On its own outward edge normal the polygon reaches no further than the edge itself,
-  // so each edge is one O(1) test: the box wholly beyond the edge's line.
-  for (std::size_t i = 0, n = convex.size(); i < n; ++i) {
-    const Vec2 e = convex[(i + 1) % n] - convex[i];
-    if (e.squaredNorm() == 0) continue;
-    const Vec2 outward = Vec2(e.y(), -e.x()).normalized();
-    double box_lo = outward.dot(corners[0]);
-    for (const Vec2& c : corners) box_lo = std::min(box_lo, outward.dot(c));
-    const double edge = outward.dot(convex[i]);
-    if (box_lo >= edge - 1e-9 * (1 + std::abs(edge))) return false;
+  for (const Vec2& axis : {Vec2(1, 0), Vec2(0, 1)}) {
+    double lo, hi;
+    project(convex, axis, lo, hi);
+    if (separates(corners, axis, lo, hi)) return false;
   }
+  return !any_side(convex, [&](const Vec2& outward, double edge) { return beyond_edge(corners, outward, edge); });
+}
+
+void convex_sides(const Polygon& convex, ConvexSides& sides) {
+  sides.outward.clear();
+  sides.offset.clear();
+  sides.usable = convex.size() >= 3;
+  if (!sides.usable) return;
+  project(convex, Vec2(1, 0), sides.x_lo, sides.x_hi);
+  project(convex, Vec2(0, 1), sides.y_lo, sides.y_hi);
+  any_side(convex, [&](const Vec2& outward, double edge) {
+    sides.outward.push_back(outward);
+    sides.offset.push_back(edge);
+    return false;
+  });
+}
+
+bool box_meets_convex(const Box& box, const ConvexSides& sides) {
+  if (!sides.usable) return false;
+  const Corners corners = corners_of(box);
+  if (separates(corners, Vec2(1, 0), sides.x_lo, sides.x_hi) || separates(corners, Vec2(0, 1), sides.y_lo, sides.y_hi))
+    return false;
+  for (std::size_t i = 0; i < sides.outward.size(); ++i)
+    if (beyond_edge(corners, sides.outward[i], sides.offset[i])) return false;
   return true;
 }
 

@@ -65,10 +65,29 @@ std::optional<Box> place_inside(const Polygon& inner, const Vec2& size, const Bo
   return std::nullopt;
 }
 
-// Objects' outer regions, filed by their bounding boxes.
+// Objects' outer regions (their requests' indices), filed by their bounding boxes.
 struct Obstacles {
-  std::vector<const Polygon*> regions;
+  std::vector<std::size_t> request;
   BoxGrid bounds;
+};
+
+// The outer regions readied for box tests (convex_sides), each when first tested: a
+// region is tested by many candidate places (its own label's, its neighbours'), and most
+// regions of a crowded screen by none.
+struct OuterSides {
+  std::span<const LabelRequest> requests;
+  std::vector<ConvexSides> sides;  // its memory kept from call to call
+  std::vector<bool> ready;
+
+  void reset(std::span<const LabelRequest> r) {
+    requests = r;
+    if (sides.size() < r.size()) sides.resize(r.size());
+    ready.assign(r.size(), false);
+  }
+  const ConvexSides& of(std::size_t i) {
+    if (!ready[i]) convex_sides(requests[i].outer, sides[i]), ready[i] = true;
+    return sides[i];
+  }
 };
 
 // Polygon i of a request, usable or not, told once per call: the checks read every vertex.
@@ -76,15 +95,16 @@ struct Usable {
   bool inner = false, outer = false;
 };
 
-std::optional<Box> place_outside(const Polygon& outer, const Box& outer_bounds, const Vec2& size,
+// The label of request i.
+std::optional<Box> place_outside(std::size_t i, const Box& outer_bounds, const Vec2& size,
                                  const LabelPlacerOptions& o, const PlacedBoxes& placed,
-                                 const Obstacles& objects) {
+                                 const Obstacles& objects, OuterSides& outer) {
   if (!o.policy) return std::nullopt;
   const std::vector<Box> candidates = o.policy(outer_bounds, size, o.screen, o.gap_px);
   const auto hides_another = [&](const Box& box) {
     return o.avoid_other_objects && objects.bounds.any_near(box, [&](std::size_t k) {
-      return objects.regions[k] != &outer && boxes_overlap(box, objects.bounds.boxes()[k]) &&
-             box_meets_convex(box, *objects.regions[k]);
+      const std::size_t j = objects.request[k];
+      return j != i && boxes_overlap(box, objects.bounds.boxes()[k]) && box_meets_convex(box, outer.of(j));
     });
   };
   // The first place that hides no other object either; failing that, the first one
@@ -92,7 +112,7 @@ std::optional<Box> place_outside(const Polygon& outer, const Box& outer_bounds, 
   std::optional<Box> fallback;
   for (const Box& box : candidates) {
     if (!(box.min.allFinite() && box.max.allFinite() && box_inside(box, o.screen) &&
-          placed.clear_of(box) && !box_meets_convex(box, outer)))
+          placed.clear_of(box) && !box_meets_convex(box, outer.of(i))))
       continue;
     if (!hides_another(box)) return box;
     if (!fallback) fallback = box;
@@ -150,6 +170,7 @@ struct LabelPlacer::Workspace {
   std::vector<Usable> usable;
   std::vector<Box> outer_bounds;  // of the usable outer regions
   Polygon centers, scratch;
+  OuterSides outer_sides;
   std::vector<std::size_t> rest;
   std::vector<Vec2> sizes;
 };
@@ -187,17 +208,18 @@ void LabelPlacer::place(std::span<const LabelRequest> requests, const LabelPlace
       }
     }
   }
+  w.outer_sides.reset(requests);
   Obstacles& objects = w.objects;
-  objects.regions.clear();
+  objects.request.clear();
   objects.bounds.reset(o.screen, cells);
   if (o.avoid_other_objects)
     for (std::size_t i = 0; i < n; ++i)
       if (w.usable[i].outer)
-        objects.regions.push_back(&requests[i].outer), objects.bounds.insert(w.outer_bounds[i]);
+        objects.request.push_back(i), objects.bounds.insert(w.outer_bounds[i]);
   for (std::size_t i = 0; i < n; ++i) {
     if (labels[i].anchored || !w.usable[i].outer) continue;
     const Vec2 size = sane_size(requests[i].size_px);
-    if (auto box = place_outside(requests[i].outer, w.outer_bounds[i], size, o, placed, objects)) {
+    if (auto box = place_outside(i, w.outer_bounds[i], size, o, placed, objects, w.outer_sides)) {
       labels[i] = {*box, LabelPlacement::outside_outer, true, leader_to(*box, requests[i].outer),
                    true};
       placed.insert(*box);

@@ -1,6 +1,8 @@
 #pragma once
 // Axis-aligned boxes in pixels (labels, selection targets, the screen) and their tests
 // against each other and against convex polygons.
+#include <vector>
+
 #include "covtrack/client/polygon.hpp"
 
 namespace covtrack::client {
@@ -32,6 +34,19 @@ inline bool box_inside(const Box& inner, const Box& outer, double tolerance_px =
 Polygon box_polygon(const Box& box);
 // The interiors of the box and of a convex polygon meet (separating-axis test).
 bool box_meets_convex(const Box& box, const Polygon& convex);
+
+// A convex polygon readied for many box_meets_convex tests: its extents along the two
+// axes and its edges' outward unit normals, each computed once instead of once per box
+// (the label placer tests every candidate place against the objects near it). The same
+// answers as box_meets_convex, bit for bit.
+struct ConvexSides {
+  double x_lo = 0, x_hi = 0, y_lo = 0, y_hi = 0;
+  std::vector<Vec2> outward;  // of each edge of non-zero length
+  std::vector<double> offset;  // outward . the edge's first vertex
+  bool usable = false;         // three vertices or more
+};
+void convex_sides(const Polygon& convex, ConvexSides& sides);  // keeps sides' memory
+bool box_meets_convex(const Box& box, const ConvexSides& sides);
 // The point of the box nearest to `point` (the point itself when inside).
 Vec2 nearest_point_on_box(const Box& box, const Vec2& point);
 // Smallest box holding the polygon (a zero box for an empty one).
