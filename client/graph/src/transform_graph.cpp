@@ -380,11 +380,20 @@ Result<QueryResult> TransformGraph::query_locked(FrameIndex a, FrameIndex b, std
     for (std::size_t k = 0; k < factors.size(); ++k) {
       const bool up = k < path_A.size();
       const FrameIndex child = up ? path_A[k] : path_B[k - path_A.size()];
+      ChainFactor& factor = factors[up ? k : factors.size() - 1 - (k - path_A.size())];
+      // An edge of one source (no combiner) is that source's value: read into its factor
+      // without edge_value's wrapping (a copy and a result per edge).
+      if (const Edge& edge = frames_[child].edge; !edge.combiner) {
+        const UncertainPose v = source_value(edge.sources.front(), now_us);
+        out.pose.unbounded = out.pose.unbounded || v.unbounded;
+        factor = {v.T, v.covariance, up};
+        continue;
+      }
       auto v = edge_value(child, now_us);
       if (!v) return std::unexpected(v.error());
       if (v->choice) out.combiner_choices.push_back(*v->choice);
       out.pose.unbounded = out.pose.unbounded || v->value.unbounded;
-      factors[up ? k : factors.size() - 1 - (k - path_A.size())] = {v->value.T, v->value.covariance, up};
+      factor = {v->value.T, v->value.covariance, up};
     }
     const UncertainPose p = compose_chain(factors);
     out.pose.T = p.T;

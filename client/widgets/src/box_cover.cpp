@@ -30,8 +30,10 @@ void BoxCover::reset(const Box& area) {
 }
 
 void BoxCover::insert(const Box& box) {
-  if (cells_.empty() || !box.min.allFinite() || !box.max.allFinite()) return;
-  const auto index = static_cast<std::uint32_t>(boxes_.size());
+  if (cells_.empty() || !box.min.allFinite() || !box.max.allFinite() ||
+      boxes_.size() > std::numeric_limits<Index>::max())
+    return;
+  const auto index = static_cast<Index>(boxes_.size());
   boxes_.push_back(box);
   const Range r{column(box.min.x()), column(box.max.x()), row(box.min.y()), row(box.max.y())};
   for (int y = r.y0; y <= r.y1; ++y) std::fill_n(cells_.begin() + y * across_x_ + r.x0, r.x1 - r.x0 + 1, index);

@@ -29,11 +29,11 @@ class BoxCover {
     if (cells_.empty() || !box.min.allFinite() || !box.max.allFinite()) return false;
     const int x0 = column(box.min.x()), x1 = column(box.max.x());
     const int y0 = row(box.min.y()), y1 = row(box.max.y());
-    const std::uint32_t* top = cells_.data() + y0 * across_x_;
-    const std::uint32_t* bottom = cells_.data() + y1 * across_x_;
+    const Index* top = cells_.data() + y0 * across_x_;
+    const Index* bottom = cells_.data() + y1 * across_x_;
     // All four tested, without branches: which corner hits is unpredictable, and an empty
     // cell names the box that overlaps nothing.
-    const auto overlaps = [&](std::uint32_t i) {
+    const auto overlaps = [&](Index i) {
       const Box& b = boxes_[i];
       return (box.min.x() < b.max.x()) & (b.min.x() < box.max.x()) & (box.min.y() < b.max.y()) &
              (b.min.y() < box.max.y());
@@ -45,14 +45,18 @@ class BoxCover {
   static constexpr int kMaxCellsAcross = 128;
 
  private:
-  // Clamped in double before the conversion (a far-off coordinate would overflow an int).
-  int column(double x) const { return static_cast<int>(std::clamp((x - origin_.x()) * per_px_.x(), 0.0, max_x_)); }
-  int row(double y) const { return static_cast<int>(std::clamp((y - origin_.y()) * per_px_.y(), 0.0, max_y_)); }
+  // Clamped in double before the conversion (a far-off coordinate would overflow an int);
+  // by max and min rather than std::clamp, which branches (finite coordinates only).
+  int column(double x) const { return static_cast<int>(std::min(std::max((x - origin_.x()) * per_px_.x(), 0.0), max_x_)); }
+  int row(double y) const { return static_cast<int>(std::min(std::max((y - origin_.y()) * per_px_.y(), 0.0), max_y_)); }
 
   Vec2 origin_ = Vec2::Zero(), per_px_ = Vec2::Ones();
   int across_x_ = 0, across_y_ = 0;
   double max_x_ = 0, max_y_ = 0;  // across - 1
-  std::vector<std::uint32_t> cells_;  // row by row: an index into boxes_
+  // Two bytes a cell keep the raster small enough to stay in the nearest cache; the boxes
+  // filed after the first 65,535 are not named in it (the grid still has them).
+  using Index = std::uint16_t;
+  std::vector<Index> cells_;  // row by row: an index into boxes_
   std::vector<Box> boxes_;             // [0]: NaN, overlapping nothing; then as filed
   // The cell ranges written since the last reset, cleared by the next one: a frame's few
   // labels, not the whole raster.
