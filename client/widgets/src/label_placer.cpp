@@ -5,6 +5,7 @@
 
 #include "box_cover.hpp"
 #include "box_grid.hpp"
+#include "corner_list.hpp"
 #include "covtrack/client/convex_polygon.hpp"
 #include "covtrack/client/space_manager.hpp"
 
@@ -173,6 +174,8 @@ struct LabelPlacer::Workspace {
   OuterSides outer_sides;
   std::vector<std::size_t> rest;
   std::vector<Vec2> sizes;
+  BoxGrid list_grid;
+  std::vector<Box> list;
 };
 
 LabelPlacer::LabelPlacer() : work_(std::make_unique<Workspace>()) {}
@@ -211,7 +214,7 @@ void LabelPlacer::place(std::span<const LabelRequest> requests, const LabelPlace
   w.outer_sides.reset(requests);
   Obstacles& objects = w.objects;
   objects.request.clear();
-  objects.bounds.reset(o.screen, cells);
+  objects.bounds.reset(o.screen, std::max(cells / 2, 1));
   if (o.avoid_other_objects)
     for (std::size_t i = 0; i < n; ++i)
       if (w.usable[i].outer)
@@ -229,7 +232,8 @@ void LabelPlacer::place(std::span<const LabelRequest> requests, const LabelPlace
   w.sizes.clear();
   for (std::size_t i = 0; i < n; ++i)
     if (!labels[i].anchored) w.rest.push_back(i), w.sizes.push_back(sane_size(requests[i].size_px));
-  const std::vector<Box> list = stack_in_corner(w.sizes, placed.grid.boxes(), o.screen, o.gap_px);
+  stack_in_corner(w.sizes, placed.grid.boxes(), o.screen, o.gap_px, w.list_grid, w.list);
+  const std::vector<Box>& list = w.list;
   for (std::size_t k = 0; k < w.rest.size(); ++k) {
     PlacedLabel& label = labels[w.rest[k]];
     label.box = list[k];

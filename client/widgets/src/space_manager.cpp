@@ -3,16 +3,24 @@
 #include <algorithm>
 #include <cmath>
 
-#include "box_grid.hpp"
+#include "corner_list.hpp"
 
 namespace covtrack::client {
 
 std::vector<Box> stack_in_corner(std::span<const Vec2> sizes, std::span<const Box> occupied,
                                  const Box& screen, double gap) {
+  BoxGrid taken;
   std::vector<Box> placed;
+  stack_in_corner(sizes, occupied, screen, gap, taken, placed);
+  return placed;
+}
+
+void stack_in_corner(std::span<const Vec2> sizes, std::span<const Box> occupied, const Box& screen,
+                     double gap, BoxGrid& taken, std::vector<Box>& placed) {
+  placed.clear();
   // Cells about a label's size when the list is long.
   const auto boxes = static_cast<double>(occupied.size() + sizes.size());
-  BoxGrid taken(screen, std::clamp(static_cast<int>(std::sqrt(boxes)), 1, 64));
+  taken.reset(screen, std::clamp(static_cast<int>(std::sqrt(boxes)), 1, 64));
   // Below every occupied box and the screen, a box can only meet the list's own boxes,
   // and those of its column are above it and those of earlier columns to its left: there
   // nothing is looked up or filed (a list that outgrows the screen would otherwise pile
@@ -51,7 +59,6 @@ std::vector<Box> stack_in_corner(std::span<const Vec2> sizes, std::span<const Bo
       break;
     }
   }
-  return placed;
 }
 
 }  // namespace covtrack::client
