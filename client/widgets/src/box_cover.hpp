@@ -24,8 +24,9 @@ class BoxCover {
   // Files the box in the cells it meets (the last one filed there wins).
   void insert(const Box& box);
 
-  // A box filed in the cell of one of box's corners overlaps box.
-  bool overlap_at_corners(const Box& box) const {
+  // A box filed in the cell of one of box's corners overlaps box. Always inlined: asked
+  // of every candidate place, whose finiteness the caller has just checked too.
+  [[gnu::always_inline]] bool overlap_at_corners(const Box& box) const {
     if (cells_.empty() || !box.min.allFinite() || !box.max.allFinite()) return false;
     const int x0 = column(box.min.x()), x1 = column(box.max.x());
     const int y0 = row(box.min.y()), y1 = row(box.max.y());

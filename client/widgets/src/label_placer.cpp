@@ -35,7 +35,7 @@ struct PlacedBoxes {
     cover.insert(box);
     grid.insert(box);
   }
-  bool clear_of(const Box& box) const {
+  [[gnu::always_inline]] bool clear_of(const Box& box) const {
     if (cover.overlap_at_corners(box)) return false;
     return !grid.any_near(box, [&](std::size_t i) { return boxes_overlap(box, grid.boxes()[i]); });
   }
