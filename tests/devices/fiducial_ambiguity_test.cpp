@@ -28,7 +28,7 @@ TEST(FiducialAmbiguity, OkPosesHoldTheirTruthAndAmbiguousOnesCoverBothSolutions)
   for (int view = 0; view < 12; ++view) {
     CalibrationView v;
     v.camera = test::camera(640, 480, 62);
-    v.formation = test::random_formation(rng, Rasteriser::AnalyticArea);
+    v.formation = test::random_formation(rng, Rasteriser::JitteredPoints);
     // 0.05-0.07 m at 0.6-0.9 m: 35-75 px across, turned by at most 5 degrees.
     v.tag = {view, 0.06 + 0.01 * u(rng),
              test::tag_pose(0.75 + 0.15 * u(rng), 5 * u(rng), 5 * u(rng), 180 * u(rng), 0.05 * u(rng),

@@ -1,7 +1,7 @@
 // Tag bundles: one pose for a rigid set of tags from all their corners.
 //  - The maths alone: corners drawn from exactly the covariance the model states give a
 //    bundle NEES of chi-square(6), and tags that agree at the limit's rate.
-//  - On renders from the held-out side of the corner model's calibration (the analytic
+//  - On renders from the held-out side of the corner model's calibration (the random-point
 //    rasteriser, an 800x600 camera, the validation families), with tags smaller than the
 //    calibration's and shapes it never saw (a flat board of six tags of two sizes, a tent
 //    of four tags on two panels at +-30 degrees): the bundle's NEES against its true pose,
@@ -124,7 +124,7 @@ class Renderer {
     TagDetector& detector = *detectors_[static_cast<std::size_t>(f)];
     std::vector<RenderedTag> scene;
     for (const BundleTag& t : rendered) scene.push_back({t.id, t.size_m, T_camera_bundle * t.T_bundle_tag});
-    const ImageFormation formation = test::random_formation(rng, Rasteriser::AnalyticArea);
+    const ImageFormation formation = test::random_formation(rng, Rasteriser::JitteredPoints);
     const cv::Mat image = form_image(camera_, detector.family(), scene, formation, rng);
     const double noise = estimate_image_noise(image);
     FrameResult out;
@@ -265,13 +265,11 @@ TEST(FiducialBundle, NeesOfTheBundlePoseOnHeldOutRenders) {
   EXPECT_LT((sum[0] + sum[1]) / all, hi);
   EXPECT_LT(sum[0] / n[0], board_hi);
   EXPECT_LT(sum[1] / n[1], tent_hi);
-  // The tents (a non-planar object) within both bounds.
+  // Tents (a non-planar object) and flat boards within both bounds. (Boards were 1.6-2.2x
+  // under-confident until the image noise was measured through JPEG and the model put
+  // the line fit's variance where a line fit puts it: devices/fiducial/README.md.)
   EXPECT_GT(sum[1] / n[1], tent_lo);
-  // The boards are under-confident, about 2x (measured 2.67): the corner model puts half
-  // of its independent variance into each edge's placement, which a board's pose rests
-  // on, where these renders show 0.36x of it (ResidualsByTermOnHeldOutRenders;
-  // devices/fiducial/README.md, "Still weak"). This bounds it at 2.5x.
-  EXPECT_GT(sum[0] / n[0], 6 / 2.5);
+  EXPECT_GT(sum[0] / n[0], board_lo);
   // Consistent tags are rarely called inconsistent at the default limit.
   EXPECT_LE(degraded * 100, all * 5) << "consistent bundles DEGRADED";
 }

@@ -122,7 +122,7 @@ TEST(FiducialCoplanar, TagsOfOneSheetAgreeOnTheirPlane) {
       T_sheet_tag.translation() = Vec3((id % 4 - 1.5) * kPitchM, (id / 4 - 1.0) * kPitchM, 0);
       sheet.push_back({id, kTagSizeM, T_camera_sheet * T_sheet_tag});
     }
-    const ImageFormation formation = test::random_formation(rng, Rasteriser::AnalyticArea);
+    const ImageFormation formation = test::random_formation(rng, Rasteriser::JitteredPoints);
     const cv::Mat image = form_image(cam, (*detector)->family(), sheet, formation, rng);
     const double noise = estimate_image_noise(image);
     std::vector<TagOnSheet> seen;

@@ -205,7 +205,7 @@ void print_sandwich(const char* set, const std::vector<TagRun>& runs, const Draw
 // modelled one, split into the draw-to-draw part (against the independent and line terms)
 // and the views' mean (against the systematic terms: edge, scale, turn).
 void print_tightest(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
-  double draw_obs = 0, draw_mod = 0, view_obs = 0, view_mod = 0;
+  std::map<std::string, std::array<double, 4>> groups;  // draw-to-draw and views' means: observed, modelled
   for (std::size_t v = 0; v < runs.size(); ++v) {
     std::vector<double> values;
     double indep = 0, systematic = 0;
@@ -237,12 +237,24 @@ void print_tightest(const char* set, const std::vector<TagRun>& runs, const Draw
     double mean = 0, var = 0;
     for (double x : values) mean += x / n;
     for (double x : values) var += (x - mean) * (x - mean) / (n - 1);
-    draw_obs += var, draw_mod += indep / n;
-    view_obs += mean * mean - var / n, view_mod += systematic / n;
+    // By what the model cannot see (the camera, the rasteriser, JPEG, the tone curve, ...).
+    const auto& f = runs[v].view.formation;
+    const std::string rasteriser[] = {"supersampled", "analytic", "jittered"};
+    const std::string groups_of_view[] = {
+        "all", "camera " + std::to_string(runs[v].view.camera.width_px),
+        "rasteriser " + rasteriser[static_cast<int>(f.rasteriser)], std::string("JPEG ") + (f.jpeg_quality ? "yes" : "no"),
+        std::string("gamma ") + (f.gamma > 1.7 ? "1.7-2.4" : "1.0-1.7"),
+        std::string("defocus ") + (f.defocus_radius_px > 0 ? "yes" : "no"),
+        std::string("shot noise ") + (f.full_well_e > 0 ? "yes" : "no")};
+    for (const auto& key : groups_of_view) {
+      auto& g = groups[key];
+      g[0] += var, g[1] += indep / n, g[2] += mean * mean - var / n, g[3] += systematic / n;
+    }
   }
-  std::printf("%s: the tightest direction's corner combination, observed / modelled: draw to draw %.2f, views' "
-              "means %.2f (modelled share of the views' means %.2f)\n",
-              set, draw_obs / draw_mod, view_obs / view_mod, view_mod / (view_mod + draw_mod));
+  std::printf("%s: the tightest direction's corner combination, observed / modelled: draw to draw, views' means "
+              "(modelled share of the views' means)\n", set);
+  for (const auto& [key, g] : groups)
+    std::printf("  %-22s %5.2f %5.2f (%.2f)\n", key.c_str(), g[0] / g[1], g[2] / g[3], g[3] / (g[3] + g[1]));
 }
 
 // The draw-to-draw spread of each view's corner errors (about the view's mean) split into

@@ -1,11 +1,12 @@
 // The fiducial tracker's covariance holds on images made differently from those its
 // corner model was calibrated on. Both sets draw random cameras from one population
 // (tone curve gamma 1-2.4, Gaussian blur with or without defocus, JPEG or none,
-// vignetting, shot and read noise, print contrast). Calibration: the supersampling
-// rasteriser, a 640x480 camera and a 1280x720 one with known distortion, four families
-// (both border polarities). Validation, held out in renderer, resolution, family and
-// lens: the analytic area rasteriser, an 800x600 camera and a 1920x1080 one whose
-// distortion the driver knows only approximately, four other families. Checked: every
+// vignetting, shot and read noise, print contrast). Calibration: the supersampling and the
+// exact-area rasterisers in turn, a 640x480 camera and a 1280x720 one with known
+// distortion, four families (both border polarities). Validation, held out in renderer,
+// resolution, family and lens: a third rasteriser (random points per pixel, with a fill
+// factor), an 800x600 camera and a 1920x1080 one whose distortion the driver knows only
+// approximately, four other families. Checked: every
 // condition (family x resolution x distance band) within 2x (mean NEES in [3, 12]), the
 // pooled NEES (see the bound below), and that the shipped defaults are this calibration.
 #include <gtest/gtest.h>
@@ -141,9 +142,9 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
               pooled, pooled_n, 6 - half_width, 6 + half_width);
   // Not the chi-square bounds above: a view's systematic corner errors are shared by its
   // draws, so the pool holds only as many draws of them as there are views. The pooled
-  // mean measured here (4.8) is 1.26x under-confident, outside those bounds; this asserts
-  // the pool within 1.3x either way, and every condition within 2x above
-  // (devices/fiducial/README.md, "Limits").
-  EXPECT_GT(pooled, 6 / 1.3);
-  EXPECT_LT(pooled, 6 * 1.3);
+  // mean measured here (5.14) is 1.17x under-confident, outside those bounds; this asserts
+  // the pool within 1.2x either way (1.3x before the noise was measured through JPEG), and
+  // every condition within 2x above (devices/fiducial/README.md, "Limits").
+  EXPECT_GT(pooled, 6 / 1.2);
+  EXPECT_LT(pooled, 6 * 1.2);
 }

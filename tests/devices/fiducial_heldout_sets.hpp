@@ -1,8 +1,9 @@
 #pragma once
 // The held-out NEES check's two sets of rendered views (fiducial_heldout_nees_test), also
 // read by the term-by-term probe (fiducial_corner_terms_probe): the calibration set the
-// corner model's defaults are fitted on, and the validation set that differs from it in
-// rasteriser, resolution, lens, family and seed.
+// corner model's defaults are fitted on (the supersampling and the exact-area rasterisers in
+// turn), and the validation set that differs from it in rasteriser (random points per
+// pixel, with a fill factor), resolution, lens, family and seed.
 #include <random>
 #include <string>
 #include <vector>
@@ -56,7 +57,9 @@ inline std::vector<TagRun> calibration_set() {
     TagRun r;
     r.family = families[static_cast<std::size_t>(i % 4)];
     r.view.camera = cameras[(i / 4) % 2];
-    r.view.formation = random_formation(rng, Rasteriser::Supersampled);
+    // Both rasterisers in turn (every family and camera with each), so that neither's edge
+    // profile is what the model learns.
+    r.view.formation = random_formation(rng, (i / 8) % 2 ? Rasteriser::AnalyticArea : Rasteriser::Supersampled);
     r.view.formation.true_distortion = distortion_vector(r.view.camera);
     r.view.tag = random_tag(rng, i % 30, std::uniform_real_distribution<double>(0.5, 1.5)(rng));
     runs.push_back(r);
@@ -84,7 +87,7 @@ inline std::vector<TagRun> validation_set() {
           r.family = family;
           r.view.camera = cam ? hd : svga;
           r.condition = family + (cam ? " 1920x1080" : " 800x600") + (band ? " 1-1.5 m" : " 0.5-1 m");
-          r.view.formation = random_formation(rng, Rasteriser::AnalyticArea);
+          r.view.formation = random_formation(rng, Rasteriser::JitteredPoints);
           if (cam) r.view.formation.true_distortion = lens;
           const double distance = std::uniform_real_distribution<double>(0.5, 1.0)(rng) + 0.5 * band;
           r.view.tag = random_tag(rng, i % 25, distance);

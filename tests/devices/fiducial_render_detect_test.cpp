@@ -127,11 +127,12 @@ TEST(FiducialRenderDetect, EdgeBlurGrowsWithTheRenderedBlur) {
   }
 }
 
-// The two rasterisers of the image formation are independent ways of drawing a tag
-// (texture warped onto a finer grid, exact covered area per pixel): on a sharp, noise-free,
-// linear image they must give the same picture up to the warp's sampling, and the same
-// corners to a few hundredths of a pixel.
-TEST(FiducialRenderDetect, BothRasterisersDrawTheSameTag) {
+// The three rasterisers of the image formation are independent ways of drawing a tag
+// (texture warped onto a finer grid, exact covered area per pixel, random points per pixel
+// looked up through the inverse homography): on a sharp, noise-free, linear image they must
+// give the same picture up to their sampling, and the same corners to a few hundredths of a
+// pixel.
+TEST(FiducialRenderDetect, EveryRasteriserDrawsTheSameTag) {
   const Camera cam = test::camera(640, 480, 62);
   DetectorOptions opts;
   opts.decimate = 1;
@@ -139,22 +140,29 @@ TEST(FiducialRenderDetect, BothRasterisersDrawTheSameTag) {
   ASSERT_TRUE(detector.has_value());
   const RenderedTag tag{5, 0.12, test::tag_pose(0.7, 25, 10, 33, 0.03, -0.02)};
   ImageFormation f;
-  f.read_noise = 0, f.gauss_blur_px = 0.7;
-  std::array<cv::Mat, 2> radiance;
-  std::array<std::vector<Detection>, 2> found;
-  for (int i = 0; i < 2; ++i) {
-    f.rasteriser = i ? Rasteriser::AnalyticArea : Rasteriser::Supersampled;
-    radiance[static_cast<std::size_t>(i)] = tag_radiance(cam, (*detector)->family(), {tag}, f);
+  f.read_noise = 0, f.gauss_blur_px = 0.7, f.jitter_seed = 9;
+  const Rasteriser rasterisers[] = {Rasteriser::AnalyticArea, Rasteriser::Supersampled, Rasteriser::JitteredPoints};
+  std::array<cv::Mat, 3> radiance;
+  std::array<std::vector<Detection>, 3> found;
+  for (std::size_t i = 0; i < 3; ++i) {
+    f.rasteriser = rasterisers[i];
+    radiance[i] = tag_radiance(cam, (*detector)->family(), {tag}, f);
     std::mt19937_64 rng(3);
-    found[static_cast<std::size_t>(i)] = (*detector)->detect(form_image(cam, (*detector)->family(), {tag}, f, rng));
-    ASSERT_EQ(found[static_cast<std::size_t>(i)].size(), 1u);
+    found[i] = (*detector)->detect(form_image(cam, (*detector)->family(), {tag}, f, rng));
+    ASSERT_EQ(found[i].size(), 1u);
   }
-  cv::Mat difference;
-  cv::absdiff(radiance[0], radiance[1], difference);
-  // Only pixels on an edge differ, by the warp's sub-sampling: a small share of one level.
-  EXPECT_LT(cv::mean(difference)[0], 0.002);
-  double worst = 0;
-  for (std::size_t k = 0; k < 4; ++k)
-    worst = std::max(worst, cv::norm(found[0][0].corners_px[k] - found[1][0].corners_px[k]));
-  EXPECT_LT(worst, 0.03) << "corners of the two rasterisers' images differ";
+  for (std::size_t i = 1; i < 3; ++i) {
+    cv::Mat difference;
+    cv::absdiff(radiance[0], radiance[i], difference);
+    // Only pixels on an edge differ, by the sampling: a small share of one level.
+    EXPECT_LT(cv::mean(difference)[0], 0.002) << "rasteriser " << i;
+    EXPECT_GT(cv::mean(difference)[0], 0.0) << "rasteriser " << i << " is the exact area's own";
+    double worst = 0;
+    for (std::size_t k = 0; k < 4; ++k)
+      worst = std::max(worst, cv::norm(found[0][0].corners_px[k] - found[i][0].corners_px[k]));
+    // The random points' coverage errors (up to 0.017 of the contrast on this tag's edge
+    // pixels) move AprilTag's corners by up to 0.03 px; the corners' own errors against
+    // the truth are 0.02-0.06 px for all three.
+    EXPECT_LT(worst, i == 1 ? 0.03 : 0.05) << "corners of rasteriser " << i << " differ from the exact area's";
+  }
 }

@@ -58,6 +58,15 @@ inline fiducial::ImageFormation random_formation(std::mt19937_64& rng, fiducial:
   f.read_noise = in(1, 7);
   f.full_well_e = u(rng) < 0.5 ? in(3000, 8000) : 0;
   f.paper = in(0.7, 0.9), f.ink = in(0.03, 0.1), f.background = in(0.25, 0.6);
+  if (rasteriser == fiducial::Rasteriser::JitteredPoints) {
+    // Sensors whose light-sensitive part is 70-100% of the pixel pitch (fill factor).
+    // Drawn from an engine of their own, seeded from a copy of rng, so that every other
+    // draw of a set (the tags' poses) is the same whichever rasteriser it uses.
+    std::mt19937_64 peek = rng;
+    std::mt19937_64 own(peek() ^ 0x9e3779b97f4a7c15ULL);
+    f.pixel_aperture = 0.7 + 0.3 * u(own);
+    f.jitter_seed = own();
+  }
   return f;
 }
 

@@ -190,8 +190,10 @@ int run_render(const RenderArgs& a) {
   // Levels are given in grey levels of a linear camera (gamma 1); the tone curve, if any,
   // applies on top, as a camera's does.
   fiducial::ImageFormation formation;
-  formation.rasteriser =
-      a.rasteriser == "analytic" ? fiducial::Rasteriser::AnalyticArea : fiducial::Rasteriser::Supersampled;
+  formation.rasteriser = a.rasteriser == "analytic"   ? fiducial::Rasteriser::AnalyticArea
+                         : a.rasteriser == "jittered" ? fiducial::Rasteriser::JitteredPoints
+                                                      : fiducial::Rasteriser::Supersampled;
+  formation.jitter_seed = a.seed;
   formation.ink = a.black / 255, formation.paper = a.white / 255, formation.background = a.background / 255;
   formation.gauss_blur_px = a.blur, formation.defocus_radius_px = a.defocus;
   formation.read_noise = a.noise, formation.full_well_e = a.full_well;
@@ -273,9 +275,10 @@ void add_render_tags_command(CLI::App& app) {
   cmd->add_option("--jpeg", args->jpeg, "JPEG quality the camera compresses with (0: none)")
       ->capture_default_str()->check(program::in_range(0, 100));
   cmd->add_option("--rasteriser", args->rasteriser, "how tags are drawn: supersampled (texture "
-                                                    "warped 4x finer, area-averaged) or analytic "
-                                                    "(exact covered area per pixel)")
-      ->capture_default_str()->check(CLI::IsMember({"supersampled", "analytic"}));
+                                                    "warped 4x finer, area-averaged), analytic "
+                                                    "(exact covered area per pixel) or jittered "
+                                                    "(256 random points per pixel)")
+      ->capture_default_str()->check(CLI::IsMember({"supersampled", "analytic", "jittered"}));
   cmd->callback([args] {
     const int rc = run_render(*args);
     if (rc != 0) throw CLI::RuntimeError(rc);

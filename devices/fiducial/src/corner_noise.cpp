@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -101,32 +102,38 @@ CornerInputs measure_corner_inputs(const cv::Mat& gray, const Detection& d, cons
 
 double estimate_image_noise(const cv::Mat& gray) {
   CV_Assert(gray.type() == CV_8UC1);
+  // Measured on 2x2 block sums, not single pixels: JPEG removes most of a frame's
+  // finest-scale noise (which a per-pixel filter sees) but keeps the coarser noise that
+  // moves an edge fitted over several pixels. For white noise both scales give sigma.
   // The filter [1 -2 1; -2 4 -2; 1 -2 1] cancels any locally planar image and leaves
-  // 6 sigma of white noise in its standard deviation; a median needs no edge mask.
-  // Responses are integers in [0, 16 * 255]: a histogram gives the exact median without
-  // storing or partially sorting them (that was most of this function's time).
-  constexpr int kStep = 3;
-  constexpr int kMaxResponse = 16 * 255;
-  std::array<std::uint32_t, kMaxResponse + 1> counts{};
+  // 6 sigma_sum = 12 sigma of white noise in its standard deviation; a median needs no
+  // edge mask. Responses are integers in [0, 16 * 4 * 255]: a histogram gives the exact
+  // median without storing or partially sorting them.
+  constexpr int kStep = 2;  // in blocks
+  constexpr int kMaxResponse = 16 * 4 * 255;
+  std::vector<std::uint32_t> counts(kMaxResponse + 1, 0);
+  const int block_rows = gray.rows / 2, block_cols = gray.cols / 2;
+  const auto block = [&](int r, int c) {
+    const std::uint8_t* a = gray.ptr<std::uint8_t>(2 * r) + 2 * c;
+    const std::uint8_t* b = gray.ptr<std::uint8_t>(2 * r + 1) + 2 * c;
+    return a[0] + a[1] + b[0] + b[1];
+  };
   std::uint32_t n = 0;
-  for (int r = 1; r + 1 < gray.rows; r += kStep) {
-    const std::uint8_t* a = gray.ptr<std::uint8_t>(r - 1);
-    const std::uint8_t* b = gray.ptr<std::uint8_t>(r);
-    const std::uint8_t* c = gray.ptr<std::uint8_t>(r + 1);
-    for (int x = 1; x + 1 < gray.cols; x += kStep) {
-      const int v = a[x - 1] - 2 * a[x] + a[x + 1] - 2 * (b[x - 1] - 2 * b[x] + b[x + 1]) +
-                    c[x - 1] - 2 * c[x] + c[x + 1];
+  for (int r = 1; r + 1 < block_rows; r += kStep)
+    for (int c = 1; c + 1 < block_cols; c += kStep) {
+      const int v = block(r - 1, c - 1) - 2 * block(r - 1, c) + block(r - 1, c + 1) -
+                    2 * (block(r, c - 1) - 2 * block(r, c) + block(r, c + 1)) + block(r + 1, c - 1) -
+                    2 * block(r + 1, c) + block(r + 1, c + 1);
       ++counts[static_cast<std::size_t>(std::abs(v))];
       ++n;
     }
-  }
   if (n == 0) return 0;
   // The element a sort would put at index n / 2.
   std::uint32_t seen = 0;
   int median = 0;
   while ((seen += counts[static_cast<std::size_t>(median)]) <= n / 2) ++median;
-  // For Gaussian noise the median of |N(0, 36 sigma^2)| is 0.6745 * 6 sigma.
-  return median / (0.6745 * 6.0);
+  // For Gaussian noise the median of |N(0, 144 sigma^2)| is 0.6745 * 12 sigma.
+  return median / (0.6745 * 12.0);
 }
 
 namespace {

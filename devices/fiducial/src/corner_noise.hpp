@@ -78,20 +78,20 @@ struct CornerInputs {
 // population (tone curves gamma 1-2.4, blur 0.4-1.25 px plus defocus, JPEG 75-97 or none;
 // devices/fiducial/README.md); config/schema.md lists the same values.
 struct CornerNoiseModel {
-  double gain_px = 1.2035;
-  double floor_px = 0.0312;         // independent of the tag's size
-  double sample_floor_px = 0.0372;  // per edge sample: averaged by the edge fit (above)
-  double aligned_px = 0.0546;
-  double shift_px = 1.5810;        // outward edge shift with all-white cells inside, zero border
-  double shift_falloff = 0.19;     // how fast it fades with border / blur (see above)
-  double shift_sigma_px = 1.6220;  // the shift correction's uncertainty at reach 1
-  double scale_bias_per_blur = -0.2608;  // every edge's mean outward error per px of blur,
+  double gain_px = 1.7504;
+  double floor_px = 0.0191;         // independent of the tag's size
+  double sample_floor_px = 0.0318;  // per edge sample: averaged by the edge fit (above)
+  double aligned_px = 0.0291;
+  double shift_px = 1.7258;        // outward edge shift with all-white cells inside, zero border
+  double shift_falloff = 0.20;     // how fast it fades with border / blur (see above)
+  double shift_sigma_px = 1.6960;  // the shift correction's uncertainty at reach 1
+  double scale_bias_per_blur = -0.2592;  // every edge's mean outward error per px of blur,
                                          // for a dark square (a light one: the opposite)
-  double scale_sigma_px = 0.0;     // the four edges' common outward error: its floor
-  double scale_per_blur = 0.1389;  //   and its growth per px of edge blur
+  double scale_sigma_px = 0.0251;     // the four edges' common outward error: its floor
+  double scale_per_blur = 0.1335;  //   and its growth per px of edge blur
   double edge_sigma_px = 0.0161;   // each edge's own outward error: its floor
   double edge_per_blur = 0.0;      //   and its growth per px of edge blur
-  double tilt_sigma_px = 0.0104;   // each edge's own turn (its ends' opposite outward
+  double tilt_sigma_px = 0.0108;   // each edge's own turn (its ends' opposite outward
   double tilt_per_blur = 0.0;      //   errors, px at each end): floor and growth per px blur
 
   // Per edge: exp(-shift_falloff (border / blur)^2).
@@ -122,7 +122,8 @@ CornerInputs measure_corner_inputs(const cv::Mat& gray, const Detection& detecti
                                    const TagFamily& family, double image_noise);
 
 // The image's noise standard deviation (grey levels), from the median absolute response
-// of a 3x3 second-difference filter on a sparse grid (robust to the few edge pixels).
+// of a 3x3 second-difference filter on a sparse grid of 2x2-pixel block sums (robust to
+// the few edge pixels, and to JPEG, which removes the finest-scale noise).
 double estimate_image_noise(const cv::Mat& gray);
 
 // Grey-level step across the detected square's edges: samples half a cell inside and

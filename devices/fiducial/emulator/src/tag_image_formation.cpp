@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -68,35 +69,103 @@ Polygon project_rect(const Camera& camera, const Pose& T, double x0, double y0, 
   return out;
 }
 
+// A printed tag on its plane: its cells with the white margin around them, one cell's
+// size and half the whole print's width (m).
+struct PrintedTag {
+  cv::Mat cells;  // CV_8U, >= 128 white
+  double cell_m = 0, half_m = 0;
+};
+
+// Nothing when the family has no such id or part of the print lies behind the camera.
+std::optional<PrintedTag> printed_tag(const TagFamily& family, const RenderedTag& tag, int margin_cells) {
+  auto cells = family.cells(tag.id);
+  if (!cells) return std::nullopt;
+  PrintedTag p;
+  cv::copyMakeBorder(*cells, p.cells, margin_cells, margin_cells, margin_cells, margin_cells, cv::BORDER_CONSTANT, 255);
+  p.cell_m = tag.size_m / family.cells_across_border();
+  p.half_m = p.cell_m * p.cells.cols / 2;
+  for (double sx : {-1.0, 1.0})
+    for (double sy : {-1.0, 1.0})
+      if ((tag.T_camera_tag * Vec3(sx * p.half_m, sy * p.half_m, 0)).z() <= 1e-3) return std::nullopt;
+  return p;
+}
+
 cv::Mat analytic_radiance(const Camera& camera, const TagFamily& family,
                           const std::vector<RenderedTag>& tags, const ImageFormation& f) {
   cv::Mat image(camera.height_px, camera.width_px, CV_32F, cv::Scalar(f.background));
-  const int margin = std::max(0, f.margin_cells);
   for (const RenderedTag& tag : tags) {
-    auto cells = family.cells(tag.id);
-    if (!cells) continue;
-    const int total = cells->cols + 2 * margin;
-    const double cell_m = tag.size_m / family.cells_across_border();
-    const double h = cell_m * total / 2;
-    bool in_front = true;
-    for (double sx : {-1.0, 1.0})
-      for (double sy : {-1.0, 1.0}) in_front &= (tag.T_camera_tag * Vec3(sx * h, sy * h, 0)).z() > 1e-3;
-    if (!in_front) continue;
+    const auto p = printed_tag(family, tag, std::max(0, f.margin_cells));
+    if (!p) continue;
+    const double h = p->half_m;
     // The paper first, then each row's runs of black cells on it. (Tags must not overlap:
     // coverage is added, not composited.)
     add_polygon(image, project_rect(camera, tag.T_camera_tag, -h, -h, h, h),
                 static_cast<float>(f.paper - f.background));
-    for (int r = 0; r < cells->rows; ++r) {
-      const std::uint8_t* row = cells->ptr<std::uint8_t>(r);
-      for (int c = 0; c < cells->cols;) {
+    for (int r = 0; r < p->cells.rows; ++r) {
+      const std::uint8_t* row = p->cells.ptr<std::uint8_t>(r);
+      for (int c = 0; c < p->cells.cols;) {
         if (row[c] >= 128) { ++c; continue; }
         int end = c;
-        while (end < cells->cols && row[end] < 128) ++end;
-        const double x0 = -h + (margin + c) * cell_m, x1 = -h + (margin + end) * cell_m;
-        const double y0 = -h + (margin + r) * cell_m;
-        add_polygon(image, project_rect(camera, tag.T_camera_tag, x0, y0, x1, y0 + cell_m),
+        while (end < p->cells.cols && row[end] < 128) ++end;
+        const double x0 = -h + c * p->cell_m, x1 = -h + end * p->cell_m, y0 = -h + r * p->cell_m;
+        add_polygon(image, project_rect(camera, tag.T_camera_tag, x0, y0, x1, y0 + p->cell_m),
                     static_cast<float>(f.ink - f.paper));
         c = end;
+      }
+    }
+  }
+  return image;
+}
+
+cv::Mat jittered_radiance(const Camera& camera, const TagFamily& family,
+                          const std::vector<RenderedTag>& tags, const ImageFormation& f) {
+  constexpr int kGrid = 16;
+  constexpr double kPoints = kGrid * kGrid;
+  cv::Mat image(camera.height_px, camera.width_px, CV_32F, cv::Scalar(f.background));
+  cv::RNG rng(f.jitter_seed);
+  const double aperture = std::clamp(f.pixel_aperture, 0.05, 1.0);
+  for (const RenderedTag& tag : tags) {
+    const auto p = printed_tag(family, tag, std::max(0, f.margin_cells));
+    if (!p) continue;
+    const double h = p->half_m;
+    const cv::Matx33d to_plane = tag_plane_to_image(camera, tag.T_camera_tag).inv();
+    // The print's cell under image point (u, v); (-1, -1) off the print.
+    const auto cell_at = [&](double u, double v) {
+      const cv::Vec3d q = to_plane * cv::Vec3d(u, v, 1);
+      const int col = static_cast<int>(std::floor((q[0] / q[2] + h) / p->cell_m));
+      const int row = static_cast<int>(std::floor((q[1] / q[2] + h) / p->cell_m));
+      if (col < 0 || row < 0 || col >= p->cells.cols || row >= p->cells.rows) return cv::Point(-1, -1);
+      return cv::Point(col, row);
+    };
+    const auto level = [&](cv::Point cell) { return p->cells.at<std::uint8_t>(cell) >= 128 ? f.paper : f.ink; };
+    double u0 = 1e18, v0 = 1e18, u1 = -1e18, v1 = -1e18;
+    for (const auto& q : project_rect(camera, tag.T_camera_tag, -h, -h, h, h))
+      u0 = std::min(u0, q.x), v0 = std::min(v0, q.y), u1 = std::max(u1, q.x), v1 = std::max(v1, q.y);
+    const int c0 = std::max(0, static_cast<int>(std::floor(u0))), c1 = std::min(image.cols - 1, static_cast<int>(std::ceil(u1)));
+    const int r0 = std::max(0, static_cast<int>(std::floor(v0))), r1 = std::min(image.rows - 1, static_cast<int>(std::ceil(v1)));
+    const double half = aperture / 2;
+    for (int r = r0; r <= r1; ++r) {
+      float* row = image.ptr<float>(r);
+      for (int c = c0; c <= c1; ++c) {
+        // A sensitive square whose four corners lie in one cell lies in it whole (a
+        // homography keeps lines straight and the cell is convex): no points needed.
+        const cv::Point corner = cell_at(c - half, r - half);
+        if (corner == cell_at(c + half, r - half) && corner == cell_at(c - half, r + half) &&
+            corner == cell_at(c + half, r + half)) {
+          if (corner.x >= 0) row[c] = static_cast<float>(level(corner));
+          continue;
+        }
+        double sum = 0;
+        int on_print = 0;
+        for (int i = 0; i < kGrid; ++i)
+          for (int j = 0; j < kGrid; ++j) {
+            const cv::Point cell = cell_at(c + aperture * ((j + rng.uniform(0.0, 1.0)) / kGrid - 0.5),
+                                           r + aperture * ((i + rng.uniform(0.0, 1.0)) / kGrid - 0.5));
+            if (cell.x < 0) continue;
+            ++on_print;
+            sum += level(cell);
+          }
+        row[c] = static_cast<float>(row[c] * (1 - on_print / kPoints) + sum / kPoints);
       }
     }
   }
@@ -155,6 +224,7 @@ double pixel_coverage(const std::vector<cv::Point2d>& poly, int x, int y) {
 cv::Mat tag_radiance(const Camera& camera, const TagFamily& family,
                      const std::vector<RenderedTag>& tags, const ImageFormation& f) {
   if (f.rasteriser == Rasteriser::AnalyticArea) return analytic_radiance(camera, family, tags, f);
+  if (f.rasteriser == Rasteriser::JitteredPoints) return jittered_radiance(camera, family, tags, f);
   RenderLook look;
   look.background = f.background, look.black = f.ink, look.white = f.paper;
   look.blur_sigma_px = 0, look.supersample = f.supersample, look.margin_cells = f.margin_cells;

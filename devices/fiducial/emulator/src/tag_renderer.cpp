@@ -12,15 +12,14 @@ namespace {
 // below a sub-sample.
 constexpr int kTexelsPerCell = 24;
 
-// Tag-plane point (x, y, 1) to full-resolution image pixel (OpenCV convention).
-cv::Matx33d plane_to_image(const Camera& camera, const Pose& T_camera_tag) {
+}  // namespace
+
+cv::Matx33d tag_plane_to_image(const Camera& camera, const Pose& T_camera_tag) {
   const Mat3 R = T_camera_tag.rotation();
   const Vec3 t = T_camera_tag.translation();
   const cv::Matx33d Rt(R(0, 0), R(0, 1), t.x(), R(1, 0), R(1, 1), t.y(), R(2, 0), R(2, 1), t.z());
   return camera_matrix(camera) * Rt;
 }
-
-}  // namespace
 
 std::vector<cv::Point2d> projected_corners(const Camera& camera, const RenderedTag& tag) {
   const double h = tag.size_m / 2;
@@ -75,7 +74,7 @@ cv::Mat render_tags(const Camera& camera, const TagFamily& family,
     const cv::Matx33d image_to_sub(S, 0, (S - 1) / 2.0 - S * roi.x,  //
                                    0, S, (S - 1) / 2.0 - S * roi.y,  //
                                    0, 0, 1);
-    const cv::Matx33d H = image_to_sub * plane_to_image(camera, tag.T_camera_tag) * texel_to_plane;
+    const cv::Matx33d H = image_to_sub * tag_plane_to_image(camera, tag.T_camera_tag) * texel_to_plane;
     // The printed tag and its footprint (1 where a sub-sample lies on it), both averaged
     // down, so that only what the tag covers is replaced: on a rolled board, neighbouring
     // tags' bounding boxes overlap, and pasting the whole box (background included) cut

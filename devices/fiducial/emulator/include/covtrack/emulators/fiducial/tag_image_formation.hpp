@@ -3,10 +3,11 @@
 // built in: the corner noise model is calibrated on some of these formations and judged
 // on others, so what it learns is the detector's behaviour, not one edge profile.
 //
-// In order: the scene's radiance (linear, 1 = white paper at full exposure) by one of two
+// In order: the scene's radiance (linear, 1 = white paper at full exposure) by one of three
 // independent rasterisers; lens distortion; the optics' point-spread function (a
 // Gaussian and a defocus disk); vignetting; shot and read noise in linear light; the
 // camera's tone curve (gamma); 8-bit quantisation; JPEG compression.
+#include <cstdint>
 #include <random>
 #include <vector>
 
@@ -24,11 +25,18 @@ enum class Rasteriser {
   // Each pixel's exact covered area of every cell, by clipping the projected cells
   // (straight-edged quads under a pinhole) to the pixel square.
   AnalyticArea,
+  // Each pixel the mean of random points, one in each square of a 16 x 16 grid over the
+  // pixel's light-sensitive part (pixel_aperture), each looked up in the tag's cells
+  // through the inverse homography: no texture, no grid of samples shared by all pixels,
+  // and a per-pixel pattern of small coverage errors fixed by jitter_seed.
+  JitteredPoints,
 };
 
 struct ImageFormation {
   Rasteriser rasteriser = Rasteriser::AnalyticArea;
   int supersample = 4;           // Supersampled only
+  double pixel_aperture = 1.0;   // JitteredPoints only: the sensitive square's side / pitch
+  std::uint64_t jitter_seed = 0; // JitteredPoints only
   double paper = 0.85, ink = 0.06, background = 0.4;  // linear reflectances
   double exposure = 1.0;         // linear signal of reflectance 1, in full scale
   double gauss_blur_px = 0.6;    // Gaussian PSF sigma (0: none)

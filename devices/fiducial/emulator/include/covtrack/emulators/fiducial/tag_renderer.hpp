@@ -38,6 +38,10 @@ cv::Mat render_tags(const Camera& camera, const TagFamily& family,
 // The 8-bit frame a sensor would deliver: clean + N(0, sigma^2) noise, rounded, clipped.
 cv::Mat add_sensor_noise(const cv::Mat& clean, double noise_sigma, std::mt19937_64& rng);
 
+// The homography from the tag plane's (x, y, 1) (metres) to image pixels (pixel centres at
+// whole numbers) under the pinhole.
+cv::Matx33d tag_plane_to_image(const Camera& camera, const Pose& T_camera_tag);
+
 // Where the tag's four detected corners project, in the detector's order (AprilTag 3:
 // tag-frame (-s/2, +s/2), (+s/2, +s/2), (+s/2, -s/2), (-s/2, -s/2)).
 std::vector<cv::Point2d> projected_corners(const Camera& camera, const RenderedTag& tag);
