@@ -144,7 +144,9 @@ TEST(Scene, KeyframesCanScriptALostTracker) {
     auto pose = graph.query("c", "t", 0);
     ASSERT_TRUE(pose) << pose.error().message;
     EXPECT_EQ(pose->unbounded, lost) << time_s;
-    if (!lost) EXPECT_NEAR(std::sqrt(pose->covariance(0, 0)), 0.1, 1e-9);
+    if (!lost) {
+      EXPECT_NEAR(std::sqrt(pose->covariance(0, 0)), 0.1, 1e-9);
+    }
   }
   EXPECT_FALSE(parse_scene(kCamera + kTracked + "[[transform.keyframe]]\nt_s = 0\nlost = 1\n", "k.toml", "."));
 }
