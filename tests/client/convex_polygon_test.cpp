@@ -90,3 +90,17 @@ TEST(PolygonCentroid, OfASquareAndATriangle) {
   EXPECT_TRUE(polygon_centroid(triangle).isApprox(Vec2(1, 1)));
   EXPECT_NEAR(polygon_radius(square(-1, -1, 1, 1), Vec2(0, 0)), std::sqrt(2.0), 1e-12);
 }
+
+// The allocating clip sizes its output for any polygon: a comb whose teeth cross the line
+// six times gives 12 points, more than the size + 1 a convex polygon can (this wrote past
+// the end of its output once).
+TEST(ClipHalfPlane, ANonConvexPolygonKeepsEveryCrossing) {
+  const Polygon comb = {Vec2(0, 0), Vec2(1, 1), Vec2(2, 0), Vec2(3, 1), Vec2(4, 0),
+                        Vec2(5, 1), Vec2(6, 0), Vec2(6, -1), Vec2(0, -1)};
+  const Polygon below = clip_half_plane(comb, Vec2(0, 1), 0.5);
+  const Polygon expected = {Vec2(0, 0),   Vec2(0.5, 0.5), Vec2(1.5, 0.5), Vec2(2, 0),  Vec2(2.5, 0.5),
+                            Vec2(3.5, 0.5), Vec2(4, 0),   Vec2(4.5, 0.5), Vec2(5.5, 0.5), Vec2(6, 0),
+                            Vec2(6, -1),  Vec2(0, -1)};
+  ASSERT_EQ(below.size(), expected.size()) << text(below);
+  for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_TRUE(below[i].isApprox(expected[i], 1e-12)) << text(below);
+}

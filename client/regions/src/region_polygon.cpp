@@ -183,7 +183,9 @@ std::size_t clip_half_plane(std::span<const Vec2> poly, const Vec2& normal, doub
 }
 
 Polygon clip_half_plane(const Polygon& poly, const Vec2& normal, double offset) {
-  Polygon out(poly.size() + 1);
+  // Each edge adds at most two points: room for any polygon, not only a convex one (a
+  // convex one needs size + 1; a caller's non-convex polygon must not write past the end).
+  Polygon out(2 * poly.size());
   out.resize(clip_half_plane(poly, normal, offset, out.data()));
   return out;
 }

@@ -22,7 +22,8 @@ void convex_hull_indices(std::span<const Vec2> points, std::vector<int>& hull);
 Polygon convex_hull(std::span<const Vec2> points);
 // The part of a convex polygon with normal . x <= offset.
 Polygon clip_half_plane(const Polygon& convex, const Vec2& normal, double offset);
-// The same into `out`, which has room for convex.size() + 1 points; returns the count.
+// The same into `out`, which has room for convex.size() + 1 points (2 * size() for a
+// polygon that may not be convex); returns the count.
 std::size_t clip_half_plane(std::span<const Vec2> convex, const Vec2& normal, double offset,
                             Vec2* out);
 // Inside or within tolerance_px of a convex polygon.
