@@ -12,8 +12,18 @@ Box box_at_center(const Vec2& center_px, const Vec2& size_px) {
 
 Box box_at_corner(const Vec2& min_px, const Vec2& size_px) { return {min_px, min_px + size_px}; }
 
+namespace {
+using Corners = std::array<Vec2, 4>;
+
+// The box's corners in box_polygon's order, without an allocation.
+Corners corners_of(const Box& box) {
+  return {box.min, Vec2(box.max.x(), box.min.y()), box.max, Vec2(box.min.x(), box.max.y())};
+}
+}  // namespace
+
 Polygon box_polygon(const Box& b) {
-  return {b.min, Vec2(b.max.x(), b.min.y()), b.max, Vec2(b.min.x(), b.max.y())};
+  const Corners c = corners_of(b);
+  return {c.begin(), c.end()};
 }
 
 namespace {
@@ -26,12 +36,6 @@ void project(const Points& points, const Vec2& axis, double& lo, double& hi) {
     lo = std::min(lo, d);
     hi = std::max(hi, d);
   }
-}
-
-using Corners = std::array<Vec2, 4>;
-
-Corners corners_of(const Box& box) {
-  return {box.min, Vec2(box.max.x(), box.min.y()), box.max, Vec2(box.min.x(), box.max.y())};
 }
 
 // The polygon's extent [b_lo, b_hi] on `axis` separates the corners'.
