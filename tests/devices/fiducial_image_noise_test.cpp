@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include "corner_noise.hpp"
 
 using covtrack::fiducial::estimate_image_noise;
+using covtrack::fiducial::ring_noise;
 
 namespace {
 
@@ -106,5 +108,87 @@ TEST(ImageNoise, SeesThroughJpegCompression) {
     EXPECT_GT(blocks, 0.7 * sigma) << "quality " << quality;
     EXPECT_LT(blocks, 1.1 * sigma) << "quality " << quality;
     EXPECT_GT(blocks, 2 * per_pixel) << "quality " << quality;
+  }
+}
+
+namespace {
+
+// A 120 px square with a dark 12 px border on a light page (linear light 0.8 and 0.06),
+// turned by `angle_deg` about its centre, with linear-light noise of `sigma` (on the 0-1
+// scale), then a tone curve of `gamma` and 8 bits: the way a sensor's noise reaches a
+// frame. Returns the image; `corners` gets the square's outer corners.
+cv::Mat noisy_tag(double sigma, double gamma, double angle_deg, int seed, std::array<cv::Point2d, 4>& corners) {
+  const cv::Point2d centre(320.3, 240.6);
+  const double a = angle_deg * M_PI / 180, half = 60, border = 12;
+  const cv::Point2d u(std::cos(a), std::sin(a)), v(-std::sin(a), std::cos(a));
+  cv::Mat linear(480, 640, CV_32F);
+  for (int r = 0; r < linear.rows; ++r)
+    for (int c = 0; c < linear.cols; ++c) {
+      const cv::Point2d d = cv::Point2d(c, r) - centre;
+      const double m = std::max(std::abs(d.dot(u)), std::abs(d.dot(v)));
+      linear.at<float>(r, c) = m <= half && m > half - border ? 0.06f : 0.8f;
+    }
+  cv::GaussianBlur(linear, linear, {0, 0}, 0.8);
+  cv::Mat noise(linear.size(), CV_32F);
+  cv::theRNG().state = static_cast<std::uint64_t>(seed);
+  cv::randn(noise, 0.0, sigma);
+  linear = cv::min(cv::max(linear + noise, 0), 1);
+  cv::pow(linear, 1 / gamma, linear);
+  cv::Mat out;
+  linear.convertTo(out, CV_8U, 255);
+  const double sx[4] = {-1, 1, 1, -1}, sy[4] = {1, 1, -1, -1};
+  for (int k = 0; k < 4; ++k) corners[k] = centre + half * (sx[k] * u + sy[k] * v);
+  return out;
+}
+
+// The noise in the middle of a region of linear level `level`, measured on the pixels.
+double true_noise_at(double level, double sigma, double gamma) {
+  return 255 * sigma * std::pow(level, 1 / gamma - 1) / gamma;
+}
+
+}  // namespace
+
+// Under a tone curve the dark border is noisier than the light page that most of the
+// frame shows: the rings inside and outside the edges read their own levels' noise. One
+// ring gives about 90 responses, so one estimate scatters by ~12% (more at the page's
+// 0.84 grey levels, where a response is a few whole units); the mean of eight draws must
+// be within 8% of the truth, each within 40%.
+TEST(RingNoise, ReadsTheNoiseAtEachSideOfTheEdge) {
+  constexpr int kDraws = 8;
+  const std::array<double, 4> width{12, 12, 12, 12};
+  for (double angle : {0.0, 17.0, 45.0}) {
+    for (double gamma : {1.0, 2.2}) {
+      const double sigma = 0.006;
+      const double at_border = std::hypot(true_noise_at(0.06, sigma, gamma), std::sqrt(1.0 / 12));
+      const double at_page = std::hypot(true_noise_at(0.8, sigma, gamma), std::sqrt(1.0 / 12));
+      double inside = 0, outside = 0;
+      for (int seed = 1; seed <= kDraws; ++seed) {
+        std::array<cv::Point2d, 4> corners;
+        const cv::Mat image = noisy_tag(sigma, gamma, angle, seed, corners);
+        const double in = ring_noise(image, corners, width, false).sigma, out = ring_noise(image, corners, width, true).sigma;
+        EXPECT_GE(ring_noise(image, corners, width, false).responses, 80u);
+        EXPECT_NEAR(in, at_border, 0.4 * at_border) << "angle " << angle << " gamma " << gamma << " seed " << seed;
+        EXPECT_NEAR(out, at_page, 0.4 * at_page) << "angle " << angle << " gamma " << gamma << " seed " << seed;
+        EXPECT_NEAR(estimate_image_noise(image), at_page, 0.1 * at_page) << "angle " << angle << " gamma " << gamma;
+        inside += in / kDraws, outside += out / kDraws;
+      }
+      std::printf("angle %.0f, gamma %.1f: inside %.2f (true %.2f), outside %.2f (true %.2f)\n", angle, gamma, inside,
+                  at_border, outside, at_page);
+      EXPECT_NEAR(inside, at_border, 0.08 * at_border) << "angle " << angle << " gamma " << gamma;
+      EXPECT_NEAR(outside, at_page, 0.08 * at_page) << "angle " << angle << " gamma " << gamma;
+    }
+  }
+}
+
+TEST(RingNoise, NotANumberWhereTheRingIsTooThinOrOffTheImage) {
+  std::array<cv::Point2d, 4> corners;
+  const cv::Mat image = noisy_tag(0.006, 2.2, 10, 3, corners);
+  for (bool outside : {false, true}) {
+    EXPECT_TRUE(std::isnan(ring_noise(image, corners, {3, 3, 3, 3}, outside).sigma));
+    std::array<cv::Point2d, 4> away = corners;
+    for (auto& p : away) p += cv::Point2d(2000, 0);
+    EXPECT_TRUE(std::isnan(ring_noise(image, away, {12, 12, 12, 12}, outside).sigma));
+    EXPECT_TRUE(std::isnan(ring_noise(image, corners, {NAN, NAN, NAN, NAN}, outside).sigma));
+    EXPECT_EQ(ring_noise(image, corners, {NAN, NAN, NAN, NAN}, outside).responses, 0u);
   }
 }

@@ -89,12 +89,20 @@ CornerInputs measure_corner_inputs(const cv::Mat& gray, const Detection& d, cons
                                    double image_noise) {
   CornerInputs in;
   const int cells = family.cells_across_border();
-  in.image_noise = image_noise;
   in.contrast = tag_contrast(gray, d.corners_px, cells);
   in.edge_length_px = mean_edge_length_px(d.corners_px);
   in.axis_alignment = edge_axis_alignment(d.corners_px);
   in.blur_px = edge_blur_px(gray, d.corners_px, in.contrast);
   in.border_px = border_width_px(d.corners_px, cells);
+  // The edge fit's samples straddle both sides of the edge: the mean of their variances.
+  constexpr double kFrameWeight = 32;  // in responses (see the header)
+  const auto variance = [&](const RingNoise& ring) {
+    if (!std::isfinite(ring.sigma)) return image_noise * image_noise;
+    const double n = static_cast<double>(ring.responses);
+    return (n * ring.sigma * ring.sigma + kFrameWeight * image_noise * image_noise) / (n + kFrameWeight);
+  };
+  in.image_noise = std::sqrt((variance(ring_noise(gray, d.corners_px, in.border_px, false)) +
+                              variance(ring_noise(gray, d.corners_px, in.border_px, true))) / 2);
   in.inner_white = family.border_inner_white(d.id);
   in.polarity = family.reversed_border() ? -1 : 1;
   return in;
@@ -134,6 +142,54 @@ double estimate_image_noise(const cv::Mat& gray) {
   while ((seen += counts[static_cast<std::size_t>(median)]) <= n / 2) ++median;
   // For Gaussian noise the median of |N(0, 144 sigma^2)| is 0.6745 * 12 sigma.
   return median / (0.6745 * 12.0);
+}
+
+RingNoise ring_noise(const cv::Mat& gray, const std::array<cv::Point2d, 4>& c,
+                     const std::array<double, 4>& border_px, bool outside) {
+  CV_Assert(gray.type() == CV_8UC1);
+  constexpr double kStep = 4.0;       // px: the larger axis step is >= 2.8, so blocks are disjoint
+  constexpr double kMinBorder = 4.0;  // px: a 2x2 block in the middle of a thinner ring is mostly edge
+  constexpr std::size_t kMinResponses = 16;
+  const auto normal = edge_outward_normals(c);
+  std::vector<int> responses;
+  for (std::size_t e = 0; e < 4; ++e) {
+    const double width = border_px[e];
+    if (!(width >= kMinBorder)) continue;
+    const cv::Point2d a = c[e], b = c[(e + 1) % 4];
+    const double length = std::hypot(b.x - a.x, b.y - a.y);
+    const cv::Point2d along = (b - a) / std::max(length, 1e-9);
+    // The ring's middle line, a border's width clear of each corner (where the
+    // neighbouring edges' blur reaches in).
+    const cv::Point2d start = a + normal[e] * (outside ? width / 2 : -width / 2) + along * width;
+    int older = 0, old = 0, have = 0;  // the two blocks before this one, how many in a row
+    for (double s = 0; s <= length - 2 * width; s += kStep) {
+      const cv::Point2d p = start + along * s;
+      // The 2x2 block whose centre is nearest p (pixel x covers [x - 0.5, x + 0.5]).
+      const int x = static_cast<int>(std::floor(p.x)), y = static_cast<int>(std::floor(p.y));
+      if (x < 0 || y < 0 || x + 1 >= gray.cols || y + 1 >= gray.rows) {
+        have = 0;
+        continue;
+      }
+      const std::uint8_t* r0 = gray.ptr<std::uint8_t>(y) + x;
+      const std::uint8_t* r1 = gray.ptr<std::uint8_t>(y + 1) + x;
+      const int sum = r0[0] + r0[1] + r1[0] + r1[1];
+      if (have >= 2) responses.push_back(std::abs(older - 2 * old + sum));
+      older = old, old = sum, ++have;
+    }
+  }
+  if (responses.size() < kMinResponses) return {std::nan(""), responses.size()};
+  // The median of whole numbers, interpolated within its unit: with a few dozen
+  // responses of a few units each, the plain median would step by a sixth.
+  std::sort(responses.begin(), responses.end());
+  const double half = responses.size() / 2.0;
+  const int median = responses[responses.size() / 2];
+  const auto first = std::lower_bound(responses.begin(), responses.end(), median);
+  const auto last = std::upper_bound(responses.begin(), responses.end(), median);
+  const double interpolated = median - 0.5 + (half - static_cast<double>(first - responses.begin())) /
+                                                 static_cast<double>(last - first);
+  // Three disjoint block sums of white noise: the second difference has variance
+  // (1 + 4 + 1) * 4 sigma^2; the median of its absolute value is 0.6745 of that's root.
+  return {std::max(interpolated, 0.0) / (0.6745 * std::sqrt(24.0)), responses.size()};
 }
 
 namespace {

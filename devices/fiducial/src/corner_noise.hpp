@@ -7,9 +7,10 @@
 //   per edge end:           line^2  = (sample_floor_px^2 + gain_px^2 * (noise / contrast)^2)
 //                                     * 16 / max(16, L / 8)
 //
-// noise: the image's noise (grey levels), contrast: the grey-level step across the tag's
-// border, L: the tag's mean edge length (px). AprilTag fits each edge to max(16, L/8)
-// sample points placed by the image gradient; each point's error grows with
+// noise: the image noise at the tag's edges (grey levels: measure_corner_inputs),
+// contrast: the grey-level step across the tag's border, L: the tag's mean edge length
+// (px). AprilTag fits each edge to max(16, L/8) sample points placed by the image
+// gradient; each point's error grows with
 // noise / contrast and the fitted line's end (the corner) averages them. Each point also
 // has an error that image noise does not explain and that differs from point to point
 // (where the edge crosses the pixel grid, the interpolation): the line averages it the
@@ -52,6 +53,8 @@
 // A calibration on rendered views with known truth measures the coefficients
 // (fit_corner_noise in noise_calibration.hpp, run by tests/devices/fiducial_heldout_nees_test).
 #include <array>
+#include <cstddef>
+#include <limits>
 
 #include <opencv2/core.hpp>
 
@@ -63,7 +66,7 @@ namespace covtrack::fiducial {
 // What the model reads from one detection in one frame: all of it measured from the
 // image and the detection, by the driver and by the calibration alike.
 struct CornerInputs {
-  double image_noise = 0;     // grey levels (estimate_image_noise)
+  double image_noise = 0;     // grey levels, at the tag's edges (measure_corner_inputs)
   double contrast = 0;        // grey levels (tag_contrast)
   double edge_length_px = 0;  // mean edge length
   double axis_alignment = 0;  // A (edge_axis_alignment)
@@ -78,20 +81,20 @@ struct CornerInputs {
 // population (tone curves gamma 1-2.4, blur 0.4-1.25 px plus defocus, JPEG 75-97 or none;
 // devices/fiducial/README.md); config/schema.md lists the same values.
 struct CornerNoiseModel {
-  double gain_px = 1.7504;
-  double floor_px = 0.0191;         // independent of the tag's size
-  double sample_floor_px = 0.0318;  // per edge sample: averaged by the edge fit (above)
-  double aligned_px = 0.0291;
+  double gain_px = 1.1980;
+  double floor_px = 0.0163;         // independent of the tag's size
+  double sample_floor_px = 0.0308;  // per edge sample: averaged by the edge fit (above)
+  double aligned_px = 0.0293;
   double shift_px = 1.7258;        // outward edge shift with all-white cells inside, zero border
   double shift_falloff = 0.20;     // how fast it fades with border / blur (see above)
-  double shift_sigma_px = 1.6960;  // the shift correction's uncertainty at reach 1
+  double shift_sigma_px = 1.5849;  // the shift correction's uncertainty at reach 1
   double scale_bias_per_blur = -0.2592;  // every edge's mean outward error per px of blur,
                                          // for a dark square (a light one: the opposite)
-  double scale_sigma_px = 0.0251;     // the four edges' common outward error: its floor
-  double scale_per_blur = 0.1335;  //   and its growth per px of edge blur
-  double edge_sigma_px = 0.0161;   // each edge's own outward error: its floor
+  double scale_sigma_px = 0.0245;     // the four edges' common outward error: its floor
+  double scale_per_blur = 0.1301;  //   and its growth per px of edge blur
+  double edge_sigma_px = 0.0157;   // each edge's own outward error: its floor
   double edge_per_blur = 0.0;      //   and its growth per px of edge blur
-  double tilt_sigma_px = 0.0108;   // each edge's own turn (its ends' opposite outward
+  double tilt_sigma_px = 0.0105;   // each edge's own turn (its ends' opposite outward
   double tilt_per_blur = 0.0;      //   errors, px at each end): floor and growth per px blur
 
   // Per edge: exp(-shift_falloff (border / blur)^2).
@@ -118,6 +121,11 @@ struct CornerNoiseModel {
 };
 
 // All inputs for one detection; `image_noise` is the frame's (computed once per frame).
+// The detection's noise input is the root mean square of the noise in the rings inside
+// and outside its edges (ring_noise), each ring's variance drawn towards the frame's as
+// if the frame's were 32 responses more (a small tag's ring gives a few dozen, whose
+// median scatters by 15-20%: a ring read low by chance would make the pose over-confident).
+// The frame's stands in for a ring too thin to read.
 CornerInputs measure_corner_inputs(const cv::Mat& gray, const Detection& detection,
                                    const TagFamily& family, double image_noise);
 
@@ -125,6 +133,21 @@ CornerInputs measure_corner_inputs(const cv::Mat& gray, const Detection& detecti
 // of a 3x3 second-difference filter on a sparse grid of 2x2-pixel block sums (robust to
 // the few edge pixels, and to JPEG, which removes the finest-scale noise).
 double estimate_image_noise(const cv::Mat& gray);
+
+// The noise in the one-cell ring along the detected square's edges (grey levels), inside
+// it (`outside` false: the tag's border) or outside it (the ring every family keeps in
+// the other colour), by the same 2x2-block measure as estimate_image_noise, along the
+// ring's middle at 4 px steps (so that successive blocks never share a pixel at any edge
+// angle). A tone curve makes noise depend on the grey level (gamma 2.2 on linear sensor
+// noise: ~3x as large at the ink's level as at the paper's), so the frame's noise, read
+// where most of the frame is, is not the noise at either side of a tag's edge. sigma is
+// NaN where the ring is under 4 px wide or gives under 16 responses.
+struct RingNoise {
+  double sigma = std::numeric_limits<double>::quiet_NaN();  // grey levels
+  std::size_t responses = 0;                                // how many it rests on
+};
+RingNoise ring_noise(const cv::Mat& gray, const std::array<cv::Point2d, 4>& corners_px,
+                     const std::array<double, 4>& border_px, bool outside);
 
 // Grey-level step across the detected square's edges: samples half a cell inside and
 // half a cell outside each edge, at a quarter, half and three quarters of its length.
