@@ -189,6 +189,10 @@ TEST(RingNoise, NotANumberWhereTheRingIsTooThinOrOffTheImage) {
     for (auto& p : away) p += cv::Point2d(2000, 0);
     EXPECT_TRUE(std::isnan(ring_noise(image, away, {12, 12, 12, 12}, outside).sigma));
     EXPECT_TRUE(std::isnan(ring_noise(image, corners, {NAN, NAN, NAN, NAN}, outside).sigma));
+    // Corners far off the frame or not numbers: no answer, and no endless walk.
+    std::array<cv::Point2d, 4> wild = corners;
+    wild[1] = {1e300, 5}, wild[3] = {NAN, INFINITY};
+    EXPECT_EQ(ring_noise(image, wild, {12, 12, 12, 12}, outside).responses, 0u);
     EXPECT_EQ(ring_noise(image, corners, {NAN, NAN, NAN, NAN}, outside).responses, 0u);
   }
 }

@@ -157,6 +157,9 @@ RingNoise ring_noise(const cv::Mat& gray, const std::array<cv::Point2d, 4>& c,
     if (!(width >= kMinBorder)) continue;
     const cv::Point2d a = c[e], b = c[(e + 1) % 4];
     const double length = std::hypot(b.x - a.x, b.y - a.y);
+    // No edge of a tag in the frame is longer than this; a corner far off it (or not a
+    // number) must not make the walk below endless.
+    if (!(length <= 2.0 * (gray.rows + gray.cols))) continue;
     const cv::Point2d along = (b - a) / std::max(length, 1e-9);
     // The ring's middle line, a border's width clear of each corner (where the
     // neighbouring edges' blur reaches in).
