@@ -52,7 +52,9 @@ TEST(CovarianceCheck, TheNegativeEigenvalueToleranceHoldsForAnyOrientation) {
       c = (c + c.transpose()).eval() / 2;
       const auto problem = check_covariance(c);
       EXPECT_EQ(problem.has_value(), factor < -1) << "factor " << factor << " trial " << trial;
-      if (problem) EXPECT_EQ(problem->defect, CovarianceDefect::Indefinite);
+      if (problem) {
+        EXPECT_EQ(problem->defect, CovarianceDefect::Indefinite);
+      }
     }
   }
 }
