@@ -1,6 +1,6 @@
 // Run by hand (about 5 min; seconds with a cache): build/tests/devices/fiducial_corner_terms_probe [CACHE_DIR]
 // How well each term of the corner noise model matches the corner errors, by the tag's
-// size in pixels and by distance band, on the held-out check's calibration set and (for
+// size in pixels, distance band, rasteriser, tone curve and camera, on the held-out check's calibration set and (for
 // reporting only: nothing is fitted on it) its validation set. The model is the one the
 // calibration fits (fit_corner_noise), as in fiducial_heldout_nees_test. Per term, the
 // observed variance over the modelled one (1 when right): `indep` each corner's
@@ -383,6 +383,10 @@ void print_terms(const char* set, const std::vector<TagRun>& runs, const Draws& 
     std::snprintf(label, sizeof label, "edge %3.0f-%3.0f px", kEdges[b], std::min(kEdges[b + 1], 999.0));
     add_view(groups[label], runs[v], draws[v], m);
     add_view(groups[near_band(runs[v]) ? "band 0.5-1 m" : "band 1-1.5 m"], runs[v], draws[v], m);
+    const char* rasteriser[] = {"supersampled", "analytic", "jittered"};
+    add_view(groups[rasteriser[static_cast<int>(runs[v].view.formation.rasteriser)]], runs[v], draws[v], m);
+    add_view(groups[runs[v].view.formation.gamma > 1.7 ? "gamma 1.7-2.4" : "gamma 1.0-1.7"], runs[v], draws[v], m);
+    add_view(groups["camera " + std::to_string(runs[v].view.camera.width_px)], runs[v], draws[v], m);
   }
   std::printf("%s: observed / modelled variance per term\n", set);
   std::printf("  %-16s %5s %6s %6s %6s %6s %6s\n", "group", "views", "NEES", "indep", "scale", "edge", "turn");
