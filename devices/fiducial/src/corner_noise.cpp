@@ -108,6 +108,16 @@ CornerInputs measure_corner_inputs(const cv::Mat& gray, const Detection& d, cons
   return in;
 }
 
+namespace {
+// The sum of the 2x2 pixels whose top-left one is (x, y): the scale both noise measures
+// read at (see estimate_image_noise).
+int block_sum(const cv::Mat& gray, int x, int y) {
+  const std::uint8_t* a = gray.ptr<std::uint8_t>(y) + x;
+  const std::uint8_t* b = gray.ptr<std::uint8_t>(y + 1) + x;
+  return a[0] + a[1] + b[0] + b[1];
+}
+}  // namespace
+
 double estimate_image_noise(const cv::Mat& gray) {
   CV_Assert(gray.type() == CV_8UC1);
   // Measured on 2x2 block sums, not single pixels: JPEG removes most of a frame's
@@ -121,11 +131,7 @@ double estimate_image_noise(const cv::Mat& gray) {
   constexpr int kMaxResponse = 16 * 4 * 255;
   std::vector<std::uint32_t> counts(kMaxResponse + 1, 0);
   const int block_rows = gray.rows / 2, block_cols = gray.cols / 2;
-  const auto block = [&](int r, int c) {
-    const std::uint8_t* a = gray.ptr<std::uint8_t>(2 * r) + 2 * c;
-    const std::uint8_t* b = gray.ptr<std::uint8_t>(2 * r + 1) + 2 * c;
-    return a[0] + a[1] + b[0] + b[1];
-  };
+  const auto block = [&](int r, int c) { return block_sum(gray, 2 * c, 2 * r); };
   std::uint32_t n = 0;
   for (int r = 1; r + 1 < block_rows; r += kStep)
     for (int c = 1; c + 1 < block_cols; c += kStep) {
@@ -173,9 +179,7 @@ RingNoise ring_noise(const cv::Mat& gray, const std::array<cv::Point2d, 4>& c,
         have = 0;
         continue;
       }
-      const std::uint8_t* r0 = gray.ptr<std::uint8_t>(y) + x;
-      const std::uint8_t* r1 = gray.ptr<std::uint8_t>(y + 1) + x;
-      const int sum = r0[0] + r0[1] + r1[0] + r1[1];
+      const int sum = block_sum(gray, x, y);
       if (have >= 2) responses.push_back(std::abs(older - 2 * old + sum));
       older = old, old = sum, ++have;
     }
