@@ -50,6 +50,7 @@ void BM_FrameLinear(benchmark::State& state) { run_frame(state, ProjectionMethod
 void BM_FrameUnscentedPerVertexScale(benchmark::State& state) {
   run_frame(state, ProjectionMethod::unscented, false);
 }
+void BM_FrameLinearPerVertexScale(benchmark::State& state) { run_frame(state, ProjectionMethod::linear, false); }
 
 // The frame with every object's rotation error 8 degrees on each axis (the frame's are 1-5):
 // the fifth-degree cubature (the default there) against the unscented transform.
@@ -180,6 +181,7 @@ void BM_FrameInnerOnly(benchmark::State& state) {
 BENCHMARK(BM_FrameUnscented)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameLinear)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameUnscentedPerVertexScale)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameLinearPerVertexScale)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameProjectionOnlyUnscented)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameOuterOnly)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FrameInnerOnly)->Unit(benchmark::kMillisecond);

@@ -155,10 +155,7 @@ Mat2 reference_unscented(const Camera& cam, const UncertainPose& pose, const Vec
                          const UnscentedParams& ut = {}) {
   const double n_kappa = 6 + ut.kappa;  // alpha 1
   Mat6 S;
-  const double rotation_trace = pose.covariance.bottomRightCorner<3, 3>().trace();
-  const SigmaRoot root = ut.root != SigmaRoot::automatic ? ut.root
-                         : rotation_trace <= kCholeskyRootMaxRotationTraceRad2 ? SigmaRoot::cholesky
-                                                                   : SigmaRoot::symmetric;
+  const SigmaRoot root = ut.root == SigmaRoot::automatic ? SigmaRoot::cholesky : ut.root;
   if (root == SigmaRoot::cholesky) {
     S = Eigen::LLT<Mat6>(n_kappa * pose.covariance).matrixL();
   } else {
@@ -179,9 +176,10 @@ Mat2 reference_unscented(const Camera& cam, const UncertainPose& pose, const Vec
 
 TEST(Projection, UnscentedSigmaPosesAreTheSe3Exp) {
   const Camera cam = test::example_camera();
-  // The default (kappa 0; Cholesky root to 3 degrees, symmetric above), the principal
-  // root, and the dissertation's plain UT (Cholesky, kappa 3 - n).
+  // The default (kappa 0, Cholesky root), the principal and the symmetric roots, and the
+  // dissertation's plain UT (Cholesky, kappa 3 - n).
   for (UnscentedParams ut : {UnscentedParams{}, UnscentedParams{.root = SigmaRoot::principal},
+                             UnscentedParams{.root = SigmaRoot::symmetric},
                              UnscentedParams{.kappa = -3, .root = SigmaRoot::cholesky}}) {
     ut.cubature_min_rotation_trace_rad2 = INFINITY;  // sigma points at 12 degrees too
     ProjectionOptions o;

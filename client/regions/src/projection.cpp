@@ -138,14 +138,10 @@ void write_unperturbed_pose(const Mat3& R, const Vec3& t, double (&pose)[12][Poi
 
 SigmaPoses make_sigma_poses(const UncertainPose& pose, const UnscentedParams& ut) {
   const double lambda = ut.alpha * ut.alpha * (kN + ut.kappa) - kN;
-  // Above 3 degrees the default takes the symmetric root (projection.hpp says why). It and
-  // the principal root come from the eigen decomposition; so does a Cholesky root of a
+  // The default is the Cholesky root (projection.hpp says why). The symmetric and the
+  // principal roots come from the eigen decomposition; so does a Cholesky root of a
   // singular covariance (a degree of freedom known exactly).
-  SigmaRoot kind = ut.root;
-  if (kind == SigmaRoot::automatic)
-    kind = pose.covariance.bottomRightCorner<3, 3>().trace() <= kCholeskyRootMaxRotationTraceRad2
-               ? SigmaRoot::cholesky
-               : SigmaRoot::symmetric;
+  const SigmaRoot kind = ut.root == SigmaRoot::automatic ? SigmaRoot::cholesky : ut.root;
   SigmaColumns S;
   if (kind != SigmaRoot::cholesky || !scaled_square_root6(pose.covariance, kN + lambda, S)) {
     Eigen::SelfAdjointEigenSolver<Mat6> eig((kN + lambda) * pose.covariance);

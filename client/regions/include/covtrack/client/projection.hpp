@@ -27,23 +27,22 @@ using Mat26 = Eigen::Matrix<double, 2, 6>;
 //   2.5 / 2.4 / 2.4 / 2.9%; beta 1 or 2 worse.
 // Up to 3 degrees the roots agree to the Monte Carlo's own noise (Cholesky / symmetric
 // with kappa 0: 0.67 / 0.69% at 2 degrees, 0.69 / 0.60% at 3, 1.0 / 0.62% at 4, 1.6 /
-// 0.76% at 5), so the eigen decomposition the symmetric root needs is only paid above.
+// 0.76% at 5). On held-out poses (tests/client/projection_test.cpp) the order is the other
+// way (Cholesky / symmetric: 0.40 / 0.46% at 2 degrees, 0.64 / 0.77% at 5), so the default
+// takes the cheapest root, Cholesky, wherever the unscented transform is used: within 2%
+// on both sets, without an eigen decomposition per object.
 // kappa 0 also makes every weight positive (W0 = 0): the covariance is never indefinite.
-// On held-out poses (tests/client/projection_test.cpp) the worst at 10 degrees is 3.4%,
-// against 5.3% for the plain UT: so above 5 degrees the default takes a fifth-degree
-// cubature rule instead (kCubatureMinRotationTraceRad2), 0.47% there.
+// On held-out poses the worst at 10 degrees is 2.1% (Cholesky) or 3.4% (symmetric), against
+// 5.3% for the plain UT: so above 5 degrees the default takes a fifth-degree cubature rule
+// instead (kCubatureMinRotationTraceRad2), 0.47% there.
 // The matrix square root S (S S^T = (n + lambda) C) whose columns give the sigma points.
 enum class SigmaRoot {
-  automatic,  // Cholesky up to 3 degrees of rotation sigma on each axis (the rotation
-              // block's trace up to 3 (3 deg)^2), symmetric above, where it matters
+  automatic,  // Cholesky (a singular covariance: the principal root); the cubature rule
+              // takes over above 5 degrees (UnscentedParams)
   cholesky,   // lower triangular: the cheapest
   principal,  // V sqrt(D): along the covariance's principal axes
   symmetric,  // V sqrt(D) V^T: the symmetric root, an eigen decomposition per object
 };
-
-// SigmaRoot::automatic's bound on the trace of the rotation block: 3 degrees on each axis.
-inline constexpr double kCholeskyRootMaxRotationTraceRad2 =
-    3 * (3.0 * std::numbers::pi / 180) * (3.0 * std::numbers::pi / 180);
 
 // UnscentedParams' default bound above which the fifth-degree cubature rule (73 points,
 // projection.cpp) replaces the unscented transform: 5 degrees on each axis. Worst error on
