@@ -12,18 +12,24 @@ constexpr double kAprilTagPixelOffset = 0.5;
 Result<std::unique_ptr<TagDetector>> TagDetector::create(const DetectorOptions& o) {
   auto family = TagFamily::open(o.family);
   if (!family) return std::unexpected(family.error());
-  if (!(o.decimate >= 1) || !(o.quad_sigma >= 0) || o.threads < 1 || o.max_hamming < 0 ||
-      o.max_hamming > 3)
-    return fail(fmt::format("invalid detector options: decimate {} (>= 1), quad_sigma {} (>= 0), "
-                            "threads {} (>= 1), max_hamming {} (0-3)",
-                            o.decimate, o.quad_sigma, o.threads, o.max_hamming));
+  if (o.max_hamming < 0 || o.max_hamming > 3)
+    return fail(fmt::format("invalid detector options: max_hamming {} (0-3)", o.max_hamming));
   apriltag_detector_t* td = apriltag_detector_create();
-  apriltag_detector_add_family_bits(td, (*family)->get(), o.max_hamming);
-  td->quad_decimate = static_cast<float>(o.decimate);
-  td->quad_sigma = static_cast<float>(o.quad_sigma);
-  td->nthreads = o.threads;
+  std::unique_ptr<TagDetector> detector(new TagDetector(std::move(*family), td));
+  if (auto set = detector->set_search(o); !set) return std::unexpected(set.error());
+  apriltag_detector_add_family_bits(td, detector->family_->get(), o.max_hamming);
   td->refine_edges = 1;
-  return std::unique_ptr<TagDetector>(new TagDetector(std::move(*family), td));
+  return detector;
+}
+
+Result<void> TagDetector::set_search(const DetectorOptions& o) {
+  if (!(o.decimate >= 1) || !(o.quad_sigma >= 0) || o.threads < 1)
+    return fail(fmt::format("invalid detector options: decimate {} (>= 1), quad_sigma {} (>= 0), threads {} (>= 1)",
+                            o.decimate, o.quad_sigma, o.threads));
+  detector_->quad_decimate = static_cast<float>(o.decimate);
+  detector_->quad_sigma = static_cast<float>(o.quad_sigma);
+  detector_->nthreads = o.threads;
+  return {};
 }
 
 TagDetector::TagDetector(std::shared_ptr<TagFamily> family, apriltag_detector* detector)

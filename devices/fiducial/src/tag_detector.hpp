@@ -40,6 +40,11 @@ class TagDetector {
   TagDetector(const TagDetector&) = delete;
   TagDetector& operator=(const TagDetector&) = delete;
 
+  // The search's settings (decimate, quad_sigma, threads) for the next detections; the
+  // family and the bit errors corrected stay as created (their decode table is what makes
+  // creating a detector slow).
+  Result<void> set_search(const DetectorOptions& options);
+
   // `gray` must be CV_8U, one channel.
   std::vector<Detection> detect(const cv::Mat& gray);
   const TagFamily& family() const { return *family_; }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <string>
 #include <thread>
 #include <tuple>
 #include <utility>
@@ -58,18 +60,35 @@ ViewDraw one_draw(TagDetector& detector, const CalibrationView& view, std::mt199
   return d;
 }
 
+// `count` detectors of o's family, kept for the calling thread's next views: making one
+// builds the family's decode table, which for the large families (tagStandard52h13,
+// tagCircle49h12) took longer than rendering and detecting a view's draws. At most four
+// families are kept (a decode table can take tens of MB).
+Result<std::vector<std::unique_ptr<TagDetector>>*> detectors_for(const DetectorOptions& o, int count) {
+  constexpr std::size_t kFamiliesKept = 4;
+  thread_local std::map<std::pair<std::string, int>, std::vector<std::unique_ptr<TagDetector>>> kept;
+  const std::pair<std::string, int> key{o.family, o.max_hamming};
+  if (!kept.contains(key) && kept.size() >= kFamiliesKept) kept.clear();
+  auto& detectors = kept[key];
+  while (static_cast<int>(detectors.size()) < count) {
+    auto d = TagDetector::create(o);
+    if (!d) return std::unexpected(d.error());
+    detectors.push_back(std::move(*d));
+  }
+  for (auto& d : detectors)
+    if (auto set = d->set_search(o); !set) return std::unexpected(set.error());
+  return &detectors;
+}
+
 }  // namespace
 
 Result<std::vector<ViewDraw>> draw_view(const DetectorOptions& options,
                                         const CalibrationView& view, int draws,
                                         std::uint64_t seed, int threads) {
   threads = std::max(1, threads);
-  std::vector<std::unique_ptr<TagDetector>> detectors;
-  for (int t = 0; t < threads; ++t) {
-    auto d = TagDetector::create(options);
-    if (!d) return std::unexpected(d.error());
-    detectors.push_back(std::move(*d));
-  }
+  auto kept = detectors_for(options, threads);
+  if (!kept) return std::unexpected(kept.error());
+  auto& detectors = **kept;
   std::vector<ViewDraw> out(static_cast<std::size_t>(std::max(draws, 0)));
   std::vector<std::thread> workers;
   for (int t = 0; t < threads; ++t)

@@ -46,7 +46,8 @@ struct CornerErrors {
 CornerErrors corner_errors(const CornerNoiseModel& model, const ViewDraw& draw);
 
 // Renders (form_image), detects `draws` times (on `threads` threads, each with its
-// own detector); deterministic for a given seed.
+// own detector, kept for the calling thread's next views of the same family);
+// deterministic for a given seed.
 Result<std::vector<ViewDraw>> draw_view(const DetectorOptions& detector,
                                         const CalibrationView& view, int draws,
                                         std::uint64_t seed, int threads = 2);
