@@ -142,7 +142,7 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
               pooled, pooled_n, 6 - half_width, 6 + half_width);
   // Not the chi-square bounds above: a view's systematic corner errors are shared by its
   // draws, so the pool holds only as many draws of them as there are views. The pooled
-  // mean measured here (5.46) is 1.10x under-confident, outside those bounds; this asserts
+  // mean measured here (5.47) is 1.10x under-confident, outside those bounds; this asserts
   // the pool within 1.2x either way (1.3x before the noise was measured through JPEG), and
   // every condition within 2x above (devices/fiducial/README.md, "Limits").
   EXPECT_GT(pooled, 6 / 1.2);
