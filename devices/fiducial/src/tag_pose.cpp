@@ -205,7 +205,9 @@ Result<TagPose> estimate_tag_pose(const Camera& cam, const std::array<cv::Point2
   out.corner_sigma_px = sigma;
   out.corners_px = {image[0], image[1], image[2], image[3]};
   out.corner_covariance = corner_cov;
-  out.covariance = pose_covariance(corner_jacobian(cam, out.best.T_camera_tag, size_m), corner_cov);
+  // A pose's covariance from the corners', through the pinhole at that pose.
+  const auto covariance_at = [&](const Pose& T) { return pose_covariance(corner_jacobian(cam, T, size_m), corner_cov); };
+  out.covariance = covariance_at(out.best.T_camera_tag);
   out.ambiguity_chi2 = std::numeric_limits<double>::infinity();
   if (solutions.size() > 1) {
     out.second = solutions[1];
@@ -227,9 +229,7 @@ Result<TagPose> estimate_tag_pose(const Camera& cam, const std::array<cv::Point2
       const Vec6 step = boxminus(solutions[1].T_camera_tag, out.best.T_camera_tag);
       // T_second Exp(x) = T_best Exp(step) Exp(x) ~ T_best Exp(step + J_r(step)^-1 x).
       const Mat6 to_best = se3_right_jacobian(step).inverse();
-      out.covariance += step * step.transpose() +
-                        to_best * pose_covariance(corner_jacobian(cam, solutions[1].T_camera_tag, size_m), corner_cov) *
-                            to_best.transpose();
+      out.covariance += step * step.transpose() + to_best * covariance_at(solutions[1].T_camera_tag) * to_best.transpose();
       out.ambiguous = true;
     }
   }
