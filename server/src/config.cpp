@@ -143,9 +143,9 @@ void read_devices(TableReader& top, DaemonConfig& out) {
     const DriverType* type = read_type(*table, path, top.file(), top.errors());
     if (!type) continue;
     TableReader r(*table, path, *type->specs.front(), top.file(), top.errors());
-    DriverFactory make = type->read(r, name);
+    DriverOptions options = type->read(r, name);
     const std::string frame = (*table)["parent_frame"].value_or(std::string("world"));
-    if (r.boolean("enabled", true)) out.devices.push_back({name, std::string(type->type), make, frame});
+    if (r.boolean("enabled", true)) out.devices.push_back({name, std::string(type->type), std::move(options), frame});
   }
 }
 

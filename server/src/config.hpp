@@ -26,7 +26,7 @@ struct DaemonSettings {
 struct DeviceConfig {
   std::string name;
   std::string type;
-  DriverFactory make;
+  DriverOptions options;  // what make_driver (driver_factory.hpp) makes a driver from
   std::string parent_frame = "world";  // the device's parent_frame key
 };
 

@@ -8,6 +8,7 @@
 #include "covtrack/devices/interruptible_sleep.hpp"
 #include "covtrack/protocol/clock.hpp"
 #include "covtrack/protocol/wire_text.hpp"
+#include "driver_factory.hpp"
 
 namespace covtrack::server {
 namespace {
@@ -106,7 +107,7 @@ void DeviceRunner::supervise(std::stop_token stop) {
     const auto started = steady_clock::now();
     Result<void> result;
     try {  // an exception must not cross the thread boundary: it becomes a failure
-      auto driver = device_.make(run);
+      auto driver = make_driver(device_.options, run);
       result = driver->run(sink, stop);
     } catch (const std::exception& e) {
       result = fail(std::string("driver threw: ") + e.what());

@@ -1,20 +1,12 @@
 #include "driver_table.hpp"
 
-#include "covtrack/devices/fiducial/fiducial_driver.hpp"
-#include "covtrack/devices/hydra/hydra_driver.hpp"
-#include "covtrack/devices/lenz/lenz_driver.hpp"
-#include "covtrack/devices/serial6dof/serial6dof_driver.hpp"
-#include "covtrack/devices/sim/sim_driver.hpp"
-#include "covtrack/devices/vrpn/vrpn_driver.hpp"
-
 namespace covtrack::server {
 namespace {
 // The three serial 6-DOF protocols share one driver; each has its own row and keys.
 DriverType serial6dof_row(std::string_view type, std::string_view summary, serial6dof::Protocol p) {
   return {type, summary, {&serial6dof::serial6dof_device_spec(p), &serial6dof::serial6dof_station_spec(p)},
-          [p](TableReader& device, const std::string& name) -> DriverFactory {
-            auto config = serial6dof::read_serial6dof_config(device, name, p);
-            return [config](std::uint64_t run) { return serial6dof::make_serial6dof_driver(config, run); };
+          [p](TableReader& device, const std::string& name) -> DriverOptions {
+            return serial6dof::read_serial6dof_config(device, name, p);
           }};
 }
 }  // namespace
@@ -23,9 +15,8 @@ const std::vector<DriverType>& driver_types() {
   static const std::vector<DriverType> table = {
       {"sim", "simulated tracker: sensors on a moving rig, noise drawn from the reported covariance",
        {&sim::sim_device_spec(), &sim::sim_motion_spec()},
-       [](TableReader& device, const std::string& name) -> DriverFactory {
-         sim::SimConfig config = sim::read_sim_config(device, name);
-         return [config](std::uint64_t run) { return sim::make_sim_driver(config, run); };
+       [](TableReader& device, const std::string& name) -> DriverOptions {
+         return sim::read_sim_config(device, name);
        }},
       {"lenz", "Lenz Digital Plus train tracker (LI101F / LI-USB): section occupancy and dead reckoning",
        [] {
@@ -33,9 +24,8 @@ const std::vector<DriverType>& driver_types() {
          for (const auto* s : lenz::layout_specs()) specs.push_back(s);
          return specs;
        }(),
-       [](TableReader& device, const std::string& name) -> DriverFactory {
-         lenz::LenzConfig config = lenz::read_lenz_config(device, name);
-         return [config](std::uint64_t) { return lenz::make_lenz_driver(config); };
+       [](TableReader& device, const std::string& name) -> DriverOptions {
+         return lenz::read_lenz_config(device, name);
        }},
       serial6dof_row("fastrak", "Polhemus FASTRAK or InterSense IS-900 (Fastrak mode) over a serial port",
                      serial6dof::Protocol::Fastrak),
@@ -43,24 +33,21 @@ const std::vector<DriverType>& driver_types() {
       serial6dof_row("flock", "Ascension Flock of Birds (POSITION/QUATERNION) over a serial port",
                      serial6dof::Protocol::Flock),
       {"hydra", "Razer Hydra: two controllers over HID (hidapi)", {&hydra::hydra_device_spec()},
-       [](TableReader& device, const std::string& name) -> DriverFactory {
-         hydra::HydraConfig config = hydra::read_hydra_config(device, name);
-         return [config](std::uint64_t) { return hydra::make_hydra_driver(config); };
+       [](TableReader& device, const std::string& name) -> DriverOptions {
+         return hydra::read_hydra_config(device, name);
        }},
       {"fiducial", "AprilTag fiducial tracker: tag poses from a camera, video or image sequence, "
        "covariance from a calibrated corner noise model",
        {&fiducial::fiducial_device_spec(), &fiducial::fiducial_tag_spec(), &fiducial::fiducial_bundle_spec(),
         &fiducial::fiducial_bundle_tag_spec(), &fiducial::corner_calibration_spec()},
-       [](TableReader& device, const std::string& name) -> DriverFactory {
-         auto config = fiducial::read_fiducial_config(device, name);
-         return [config](std::uint64_t run) { return fiducial::make_fiducial_driver(*config, run); };
+       [](TableReader& device, const std::string& name) -> DriverOptions {
+         return fiducial::read_fiducial_config(device, name);
        }},
       {"vrpn", "a tracker served by a vrpn_server (\"Tracker0@host\"), read over TCP, republished with a "
        "covariance from config",
        {&vrpn::vrpn_device_spec(), &vrpn::vrpn_sensor_spec()},
-       [](TableReader& device, const std::string& name) -> DriverFactory {
-         vrpn::VrpnConfig config = vrpn::read_vrpn_config(device, name);
-         return [config](std::uint64_t) { return vrpn::make_vrpn_driver(config); };
+       [](TableReader& device, const std::string& name) -> DriverOptions {
+         return vrpn::read_vrpn_config(device, name);
        }},
   };
   return table;

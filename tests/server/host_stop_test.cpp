@@ -61,9 +61,10 @@ sigma_rad = [0.001, 0.001, 0.001]
   ASSERT_TRUE(config) << config.error().message;
   std::promise<void> entered;
   std::atomic<bool> returned{false};
-  config->devices.push_back({"wedged", "test", [&](std::uint64_t) {
-                               return std::make_unique<BlockedInOpen>(fifo, entered, returned);
-                             }});
+  const server::DriverFactory wedged = [&](std::uint64_t) -> std::unique_ptr<Driver> {
+    return std::make_unique<BlockedInOpen>(fifo, entered, returned);
+  };
+  config->devices.push_back({"wedged", "test", wedged});
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
   server::Host host(*config, lcm);
