@@ -147,4 +147,16 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
   // every condition within 2x above (devices/fiducial/README.md, "Limits").
   EXPECT_GT(pooled, 6 / 1.2);
   EXPECT_LT(pooled, 6 * 1.2);
+  // And 6 within the pool's 99% interval judged with the views as the independent draws:
+  // the spread of the views' own means, each weighted by its draws (the pool's standard
+  // error for clustered samples).
+  double spread = 0;
+  int posed_views = 0;
+  for (const auto& [mean, n] : view_nees)
+    if (n > 0) spread += static_cast<double>(n) * n * (mean - pooled) * (mean - pooled), ++posed_views;
+  const double clustered_se = std::sqrt(spread * posed_views / (posed_views - 1.0)) / pooled_n;
+  std::printf("with the %d views as the independent draws: standard error %.3f, 99%% interval for the pool [%.3f, %.3f]\n",
+              posed_views, clustered_se, 6 - 2.576 * clustered_se, 6 + 2.576 * clustered_se);
+  EXPECT_LE(std::abs(pooled - 6), 2.576 * clustered_se)
+      << "the pooled NEES is off 6 by more than the views' own spread allows";
 }
