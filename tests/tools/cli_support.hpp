@@ -1,12 +1,8 @@
 #pragma once
-// Shared by the tests that run the `covtrack` command: a run with its output and exit
-// code, containment in a polygon as `covtrack regions --json` prints it, and a scene for
+// Shared by the tests that run the `covtrack` command: a run of it (support/run_command.hpp
+// keeps its output and exit code), containment in a polygon as `covtrack regions --json` prints it, and a scene for
 // scripted selection.
-#include <sys/wait.h>
-
-#include <array>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -14,24 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/run_command.hpp"
+
 namespace covtrack::testing {
-
-struct CliRun {
-  int exit_code;
-  std::string out;  // stdout and stderr together
-};
-
-// A shell command line, stderr with stdout.
-inline CliRun run_command(const std::string& command) {
-  const std::string cmd = command + " 2>&1";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return {-1, "popen failed"};
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
-  const int status = ::pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
 
 // `covtrack ARGS`, with `env_prefix` (e.g. "env -u DISPLAY") before it.
 inline CliRun run_covtrack(const std::string& args, const std::string& env_prefix = "") {
