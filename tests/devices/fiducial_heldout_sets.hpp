@@ -4,6 +4,7 @@
 // corner model's defaults are fitted on (the supersampling and the exact-area rasterisers in
 // turn), and the validation set that differs from it in rasteriser (random points per
 // pixel, with a fill factor), resolution, lens, family and seed.
+#include <cstdint>
 #include <random>
 #include <string>
 #include <vector>
@@ -67,7 +68,9 @@ inline std::vector<TagRun> calibration_set() {
   return runs;
 }
 
-inline std::vector<TagRun> validation_set() {
+// `views_per_condition` views of each family x camera x distance band, drawn from `seed`
+// (the held-out test's: 23 and 8; fiducial_heldout_replication draws other sets).
+inline std::vector<TagRun> validation_set(std::uint64_t seed = 23, int views_per_condition = 8) {
   const std::vector<std::string> families = {"tag25h9", "tagStandard52h13", "tagCircle49h12", "tagCustom48h12"};
   Camera hd = camera(1920, 1080, 75);
   // The lens has barrel distortion; the calibration the driver is given is close but not
@@ -76,13 +79,13 @@ inline std::vector<TagRun> validation_set() {
   const cv::Mat lens = (cv::Mat_<double>(5, 1) << -0.12, 0.05, 0, 0, 0);
   hd.k1 = -0.12 * 1.003, hd.k2 = 0.05 * 0.99;
   const Camera svga = camera(800, 600, 58);
-  std::mt19937_64 rng(23);
+  std::mt19937_64 rng(seed);
   std::vector<TagRun> runs;
   int i = 0;
   for (const auto& family : families)
     for (int cam = 0; cam < 2; ++cam)
       for (int band = 0; band < 2; ++band)
-        for (int k = 0; k < 8; ++k, ++i) {
+        for (int k = 0; k < views_per_condition; ++k, ++i) {
           TagRun r;
           r.family = family;
           r.view.camera = cam ? hd : svga;
