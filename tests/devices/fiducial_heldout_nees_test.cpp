@@ -127,7 +127,8 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
   }
   // Near tags are large in pixels, far ones small: a term that does not follow the tag's
   // size in pixels shows as one band more conservative than the other (before the
-  // per-sample floor, near 4.38 against far 5.35).
+  // per-sample floor, near 4.38 against far 5.35). It is a coarse check: on other validation
+  // sets of this design the same model reads 1.01-1.30x (fiducial_heldout_replication).
   const auto band_mean = [&](const std::string& band) {
     const auto& [sum, n] = by_band[band];
     return n ? sum / n : 0.0;
