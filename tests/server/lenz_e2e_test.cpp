@@ -27,6 +27,7 @@
 #include "covtrack/protocol/pose_message.hpp"
 #include "daemon_process.hpp"
 #include "dead_reckoning.hpp"
+#include "support/one_percent_bar.hpp"
 
 using namespace covtrack;
 
@@ -155,8 +156,12 @@ TEST(LenzEndToEnd, EmulatorDaemonClientWithUnplugAndReplug) {
     inside += error <= lenz::kZ99 * s.sigma_along_m + 0.6 * dt + 0.01;  // max speed * dt, track model
   }
   ASSERT_GT(paired, 60);
-  std::printf("end to end: %d of %d locomotive poses hold the truth inside the 99%% interval\n", inside, paired);
-  EXPECT_GE(double(inside) / paired, 0.99);
+  // At most as many outside as a true 1% rate reaches in 99% of runs: a bar of 1% of n
+  // failed a CI run with 2 of 119 outside, which an exact covariance does in a third of runs.
+  const int most_outside = test::most_outside_at_one_percent(paired);
+  std::printf("end to end: %d of %d locomotive poses hold the truth inside the 99%% interval (at most %d may not)\n",
+              inside, paired, most_outside);
+  EXPECT_LE(paired - inside, most_outside);
 
   // Unplug: kill the emulator; its pseudo-terminal closes.
   const std::int64_t unplugged_us = now_us();
