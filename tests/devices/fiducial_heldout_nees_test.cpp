@@ -152,11 +152,8 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
   // the spread of the views' own means, each weighted by its draws (the pool's standard
   // error for clustered samples). Over eight validation sets of this design the pools
   // spread by 0.26, as this error says (fiducial_heldout_replication; the README's Limits).
-  double spread = 0;
   int posed_views = 0;
-  for (const auto& [mean, n] : view_nees)
-    if (n > 0) spread += static_cast<double>(n) * n * (mean - pooled) * (mean - pooled), ++posed_views;
-  const double clustered_se = std::sqrt(spread * posed_views / (posed_views - 1.0)) / pooled_n;
+  const double clustered_se = test::clustered_standard_error(view_nees, &posed_views);
   std::printf("with the %d views as the independent draws: standard error %.3f, 99%% interval for the pool [%.3f, %.3f]\n",
               posed_views, clustered_se, 6 - 2.576 * clustered_se, 6 + 2.576 * clustered_se);
   EXPECT_LE(std::abs(pooled - 6), 2.576 * clustered_se)

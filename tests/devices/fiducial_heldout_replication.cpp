@@ -77,9 +77,7 @@ SetResult judge_set(std::uint64_t seed, int draws_per_view, int views_per_condit
     views.emplace_back(view.mean(), view.n);
   }
   r.pooled = pool.mean(), r.draws = pool.n;
-  double spread = 0;
-  for (const auto& [mean, n] : views) spread += double(n) * n * (mean - r.pooled) * (mean - r.pooled);
-  r.views_se = std::sqrt(spread * views.size() / (views.size() - 1.0)) / pool.n;
+  r.views_se = test::clustered_standard_error(views);
   const double half = 2.576 * std::sqrt(12.0 / pool.n);
   std::printf("seed %3llu: pooled %.3f over %d draws of %zu views; independent-draw 99%% bounds [%.3f, %.3f]%s; "
               "views' standard error %.3f;",

@@ -4,7 +4,9 @@
 // corner model's defaults are fitted on (the supersampling and the exact-area rasterisers in
 // turn), and the validation set that differs from it in rasteriser (random points per
 // pixel, with a fill factor), resolution, lens, family and seed.
+#include <cmath>
 #include <cstdint>
+#include <utility>
 #include <random>
 #include <string>
 #include <vector>
@@ -97,6 +99,21 @@ inline std::vector<TagRun> validation_set(std::uint64_t seed = 23, int views_per
           runs.push_back(r);
         }
   return runs;
+}
+
+// The pooled mean's standard error when the views are the independent draws: the spread
+// of the views' mean NEES (pairs of mean and draws; views without a pose have 0 draws),
+// each weighted by its draws, with the V / (V - 1) correction. Also the number of views
+// with a pose, in `posed_views`.
+inline double clustered_standard_error(const std::vector<std::pair<double, int>>& views, int* posed_views = nullptr) {
+  double sum = 0;
+  int draws = 0, posed = 0;
+  for (const auto& [mean, n] : views) sum += mean * n, draws += n, posed += n > 0;
+  const double pooled = sum / draws;
+  double spread = 0;
+  for (const auto& [mean, n] : views) spread += static_cast<double>(n) * n * (mean - pooled) * (mean - pooled);
+  if (posed_views) *posed_views = posed;
+  return std::sqrt(spread * posed / (posed - 1.0)) / draws;
 }
 
 }  // namespace covtrack::test
