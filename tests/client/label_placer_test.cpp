@@ -199,6 +199,36 @@ TEST(SpaceManager, StepsOverOccupiedBoxesAndStartsNewColumns) {
   }
 }
 
+// The separating-axis test the placer asks of every candidate place, in both forms,
+// against the area that clipping cuts out: a box that shares area meets the polygon, and
+// one that stays clear of it by more than a rounding does not. Grid polygons put many
+// boxes exactly along an edge.
+TEST(BoxMeetsConvex, AgreesWithClippingInBothForms) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 200), size(0.5, 60);
+  int met = 0, clear = 0;
+  ConvexSides sides;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const Polygon convex = widget_testing::random_convex(rng, Vec2(100, 100), 60, 12, trial % 2);
+    convex_sides(convex, sides);
+    Vec2 corner(u(rng), u(rng));
+    if (trial % 2) corner = corner.array().round().matrix();
+    const Box box = box_at_corner(corner, Vec2(size(rng), size(rng)).array().round().max(1).matrix());
+    const bool meets = box_meets_convex(box, convex);
+    ASSERT_EQ(meets, box_meets_convex(box, sides)) << trial;
+    const Box grown{box.min - Vec2::Constant(1e-3), box.max + Vec2::Constant(1e-3)};
+    if (shared_area(box, convex) > 1e-6) {
+      EXPECT_TRUE(meets) << trial;
+      ++met;
+    } else if (shared_area(grown, convex) == 0) {
+      EXPECT_FALSE(meets) << trial;
+      ++clear;
+    }
+  }
+  EXPECT_GT(met, 1000);
+  EXPECT_GT(clear, 1000);
+}
+
 TEST(LabelPlacer, RandomScenesKeepEveryConstraint) {
   std::mt19937_64 rng(21);
   std::uniform_real_distribution<double> ux(0, 640), uy(0, 480), usize(10, 90), shrink(0.2, 0.9);

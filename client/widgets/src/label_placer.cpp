@@ -41,6 +41,12 @@ struct PlacedBoxes {
   }
 };
 
+// A box of `size` could lie within `bounds` (up to the containment tests' tolerance).
+bool could_hold(const Box& bounds, const Vec2& size) {
+  constexpr double kSlackPx = 1e-3;
+  return size.x() <= bounds.width() + kSlackPx && size.y() <= bounds.height() + kSlackPx;
+}
+
 Vec2 sane_size(const Vec2& size) {
   return {std::isfinite(size.x()) ? std::max(size.x(), 0.0) : 0.0,
           std::isfinite(size.y()) ? std::max(size.y(), 0.0) : 0.0};
@@ -113,7 +119,7 @@ std::optional<Box> place_outside(std::size_t i, const Box& outer_bounds, const V
   std::optional<Box> fallback;
   for (const Box& box : candidates) {
     if (!(box.min.allFinite() && box.max.allFinite() && box_inside(box, o.screen) &&
-          placed.clear_of(box) && !box_meets_convex(box, outer.of(i))))
+          placed.clear_of(box) && !(boxes_overlap(box, outer_bounds) && box_meets_convex(box, outer.of(i)))))
       continue;
     if (!hides_another(box)) return box;
     if (!fallback) fallback = box;
@@ -205,6 +211,9 @@ void LabelPlacer::place(std::span<const LabelRequest> requests, const LabelPlace
     for (std::size_t i = 0; i < n; ++i) {
       if (!w.usable[i].inner) continue;
       const Vec2 size = sane_size(requests[i].size_px);
+      // A box inside the region is inside its bounding box: most inner regions of a
+      // crowded screen are smaller than a label, and clipping them would tell the same.
+      if (!could_hold(bounding_box(requests[i].inner), size)) continue;
       if (auto box = place_inside(requests[i].inner, size, o.screen, placed, w.centers, w.scratch)) {
         labels[i] = {*box, LabelPlacement::inside_inner, true, std::nullopt, true};
         placed.insert(*box);
@@ -215,7 +224,7 @@ void LabelPlacer::place(std::span<const LabelRequest> requests, const LabelPlace
   Obstacles& objects = w.objects;
   objects.request.clear();
   objects.bounds.reset(o.screen, std::max(cells / 2, 1));
-  if (o.avoid_other_objects)
+  if (o.avoid_other_objects && o.policy)  // only outside places are tested against them
     for (std::size_t i = 0; i < n; ++i)
       if (w.usable[i].outer)
         objects.request.push_back(i), objects.bounds.insert(w.outer_bounds[i]);

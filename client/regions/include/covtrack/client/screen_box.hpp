@@ -16,8 +16,11 @@ struct Box {
   Vec2 center() const { return 0.5 * (min + max); }
 };
 
-Box box_at_center(const Vec2& center_px, const Vec2& size_px);
-Box box_at_corner(const Vec2& min_px, const Vec2& size_px);
+// Inline: the label placer's policies make dozens per label.
+inline Box box_at_center(const Vec2& center_px, const Vec2& size_px) {
+  return {center_px - 0.5 * size_px, center_px + 0.5 * size_px};
+}
+inline Box box_at_corner(const Vec2& min_px, const Vec2& size_px) { return {min_px, min_px + size_px}; }
 
 // Interiors meet (boxes that only touch along an edge do not overlap). Inline: the label
 // placer and the space manager test many pairs.
