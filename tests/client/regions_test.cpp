@@ -1,6 +1,7 @@
 // Ellipse polygons, hulls, expansion and contraction, assessment, honesty on Monte Carlo.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <span>
@@ -486,6 +487,70 @@ TEST(Regions, InvalidWhenBehindCamera) {
   EXPECT_TRUE(r.outer.empty());
   EXPECT_TRUE(r.inner.empty());
   EXPECT_TRUE(std::isinf(r.assessment));
+}
+
+// Numbers no tracker reports, as a damaged message or an application's bug could hand
+// them over: the object is invalid and says why, never a region of NaNs (fuzz_regions
+// found regions of NaNs, and a set of supports that overflowed split for a second).
+TEST(Regions, InvalidAndFlaggedWhenNumbersAreNotFinite) {
+  Camera cam = test::example_camera();
+  const std::vector<Vec3> box = box_vertices(0.2, 0.15, 0.1);
+  // `methods`: the projections that must flag it (the others' may find another reason).
+  const auto expect_not_finite = [&](const UncertainPose& pose, const std::vector<Vec3>& vertices,
+                                     const std::string& what,
+                                     std::vector<ProjectionMethod> methods = {ProjectionMethod::unscented,
+                                                                              ProjectionMethod::linear}) {
+    for (const ProjectionMethod method : {ProjectionMethod::unscented, ProjectionMethod::linear}) {
+      ObjectRegionOptions o;
+      o.projection.method = method;
+      const ObjectRegions r = compute_object_regions(cam, pose, vertices, o);
+      EXPECT_FALSE(r.valid) << what;
+      if (std::ranges::find(methods, method) != methods.end()) EXPECT_TRUE(r.flags.not_finite) << what;
+      EXPECT_TRUE(r.outer.empty() && r.inner.empty()) << what;
+      EXPECT_TRUE(std::isinf(r.assessment)) << what;
+    }
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  UncertainPose pose = box_pose(0.005, 1 * kDeg);
+  pose.T.translation().x() = nan;
+  expect_not_finite(pose, box, "NaN position");
+  pose = box_pose(0.005, 1 * kDeg);
+  pose.covariance(3, 3) = std::numeric_limits<double>::infinity();
+  expect_not_finite(pose, box, "infinite covariance");
+  std::vector<Vec3> bad = box;
+  bad[3].y() = nan;
+  expect_not_finite(box_pose(0.005, 1 * kDeg), bad, "NaN vertex");
+  // The vertex flag alone, and the good vertices of the same object keep theirs.
+  const ObjectRegions r = compute_object_regions(cam, box_pose(0.005, 1 * kDeg), bad);
+  for (std::size_t i = 0; i < bad.size(); ++i) EXPECT_EQ(r.vertices[i].flags.not_finite, i == 3) << i;
+  // Finite, but the pixels' covariance overflows (variances near 1e310 px^2), or finite
+  // pixels' confidence ellipses do (about 1e307 px^2 times the scale): first order. (The
+  // unscented transform's sigma points that far out lie behind the camera, or with a lens
+  // past its distortion fold: also invalid, for that reason.)
+  cam.k1 = cam.k2 = cam.k3 = cam.p1 = cam.p2 = 0;
+  for (const double variance : {1e305, 4e302}) {
+    pose = box_pose(0.005, 1 * kDeg);
+    pose.covariance(0, 0) = variance;
+    expect_not_finite(pose, box, fmt::format("x variance {}", variance), {ProjectionMethod::linear});
+  }
+}
+
+// The first-order projection of an indefinite pose covariance is repaired and flagged, as
+// the unscented transform's is, rather than handed on with a negative variance.
+TEST(Regions, LinearProjectionRepairsAnIndefiniteCovariance) {
+  const Camera cam = test::example_camera();
+  UncertainPose pose = box_pose(0.005, 1 * kDeg);
+  pose.covariance(0, 0) = -1e-3;  // x known to a negative variance
+  ObjectRegionOptions o;
+  o.projection.method = ProjectionMethod::linear;
+  const ObjectRegions r = compute_object_regions(cam, pose, box_vertices(0.2, 0.15, 0.1), o);
+  EXPECT_TRUE(r.flags.covariance_repaired);
+  for (const ProjectedVertex& v : r.vertices) {
+    EXPECT_GE(v.covariance_px2.trace(), 0);
+    EXPECT_GE(v.covariance_px2.determinant(), -1e-9 * v.covariance_px2.squaredNorm());
+  }
+  ASSERT_TRUE(r.valid);
+  EXPECT_GE(r.assessment, 0);
 }
 
 TEST(Assessment, MetricsAndAggregators) {

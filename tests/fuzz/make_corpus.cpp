@@ -3,6 +3,7 @@
 // seeds are the shipped files, copied by make_corpus.sh. Run by hand after a format
 // changes: make_corpus OUT_DIR (tests/fuzz/make_corpus.sh does both).
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -194,6 +195,58 @@ void lcm_log_seeds() {
   }
 }
 
+// fuzz_regions.cpp's layout: an options byte, the number of objects less one, then per
+// object its vertex count less one and either a pose (translation, rotation vector, the
+// covariance's upper triangle, an unbounded byte) and its vertices, or outer and inner
+// polygons (the inner's count as it is); then the label's size. Numbers are raw
+// little-endian doubles.
+struct RegionsSeed {
+  Bytes bytes;
+  void byte(std::uint8_t b) { bytes.push_back(b); }
+  void numbers(std::initializer_list<double> values) {
+    for (double v : values) {
+      std::uint8_t raw[8];
+      std::memcpy(raw, &v, sizeof raw);
+      bytes.insert(bytes.end(), raw, raw + 8);
+    }
+  }
+  // A box of half-size s at (x, y, z), turned a little, with a covariance of 2 mm and
+  // about 1 degree (or `sigma_scale` times that).
+  void box_object(double x, double y, double z, double s, double sigma_scale = 1) {
+    byte(8 - 1);
+    numbers({x, y, z, 0.1, 0.2, 0.3});
+    for (int i = 0; i < 6; ++i)
+      for (int j = i; j < 6; ++j) numbers({i != j ? 0.0 : sigma_scale * sigma_scale * (i < 3 ? 4e-6 : 3e-4)});
+    byte(0);
+    for (int k = 0; k < 8; ++k) numbers({k & 1 ? s : -s, k & 2 ? 0.7 * s : -0.7 * s, k & 4 ? 0.5 * s : -0.5 * s});
+    numbers({60, 14});
+  }
+  void square_polygons(double x, double y, double half) {
+    byte(4 - 1);
+    numbers({x - half, y - half, x + half, y - half, x + half, y + half, x - half, y + half});
+    byte(4);
+    numbers({x - half / 2, y - half / 2, x + half / 2, y - half / 2, x + half / 2, y + half / 2, x - half / 2,
+             y + half / 2});
+    numbers({50, 12});
+  }
+};
+
+void regions_seeds() {
+  RegionsSeed boxes;  // four boxes in view, unscented, whole-object scale
+  boxes.byte(0), boxes.byte(3);
+  boxes.box_object(0, 0, 2, 0.1), boxes.box_object(0.3, 0.1, 2.5, 0.15), boxes.box_object(-0.3, -0.2, 1.5, 0.05, 3),
+      boxes.box_object(0.05, 0.05, 0.3, 0.02, 10);
+  write("regions", "boxes", boxes.bytes);
+  RegionsSeed linear;  // first order, per-vertex scale, no distortion, the other policy
+  linear.byte(1 | 2 | 4 | 32), linear.byte(1);
+  linear.box_object(0.1, 0, 1.2, 0.2), linear.box_object(-0.2, 0.1, 3, 0.3, 5);
+  write("regions", "linear_boxes", linear.bytes);
+  RegionsSeed polygons;  // the placer's polygons from the input, labels never inside
+  polygons.byte(8 | 16), polygons.byte(2);
+  polygons.square_polygons(100, 100, 40), polygons.square_polygons(130, 110, 30), polygons.square_polygons(600, 460, 50);
+  write("regions", "polygons", polygons.bytes);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -207,5 +260,6 @@ int main(int argc, char** argv) {
   hydra_seeds();
   wire_message_seeds();
   lcm_log_seeds();
+  regions_seeds();
   return 0;
 }

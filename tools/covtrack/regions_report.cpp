@@ -23,6 +23,7 @@ std::vector<std::string> flag_names(const client::ProjectionFlags& f) {
   if (f.unbounded) names.push_back("unbounded");
   if (f.covariance_repaired) names.push_back("covariance_repaired");
   if (f.past_distortion_fold) names.push_back("past_distortion_fold");
+  if (f.not_finite) names.push_back("not_finite");
   if (f.depth_nonlinear) names.push_back("depth_nonlinear");
   return names;
 }

@@ -450,7 +450,11 @@ void project_linear(const Camera& camera, const UncertainPose& pose,
       v.mean_px = Vec2(b.u[j], b.v[j]);
       set_depth_sigma(v, b.zvar[j], o);
       if ((v.flags.past_distortion_fold = b.r2[j] >= fold_r2)) continue;
-      v.covariance_px2 << b.cuu[j], b.cuv[j], b.cuv[j], b.cvv[j];
+      // J C J^T is positive semi-definite for a C that is; an indefinite C is repaired and
+      // flagged as the unscented transform's result is.
+      Mat2 C;
+      C << b.cuu[j], b.cuv[j], b.cuv[j], b.cvv[j];
+      v.covariance_px2 = repair_psd(C, v.flags.covariance_repaired);
       if (add_intrinsic) v.covariance_px2 += camera.intrinsic_covariance_at(v.mean_px);
     }
   }
@@ -516,20 +520,29 @@ void project_vertices(const Camera& camera, const UncertainPose& pose,
   shared.unbounded = pose.unbounded;
   shared.rotation_too_uncertain =
       use_covariance && rotation_too_uncertain(pose.covariance, o.max_rotation_sigma_rad);
-  if (use_covariance)
-    return o.method == ProjectionMethod::unscented
-               ? project_unscented(camera, pose, points, o, shared, out)
-               : project_linear(camera, pose, points, o, shared, out);
-
-  // LOST: the pixel of the last estimate, no covariance.
-  const double fold_r2 = camera.distortion_fold_r2();
-  for (const Vec3& p : points) {
-    const Vec3 pc = pose.T * p;
-    ProjectedVertex& v = start_vertex(out, pc.z(), shared, o);
-    if (v.flags.behind_camera) continue;
-    v.mean_px = camera.project(pc);
-    v.flags.past_distortion_fold = pc.head<2>().squaredNorm() >= fold_r2 * pc.z() * pc.z();
+  if (use_covariance) {
+    if (o.method == ProjectionMethod::unscented)
+      project_unscented(camera, pose, points, o, shared, out);
+    else
+      project_linear(camera, pose, points, o, shared, out);
+  } else {
+    // LOST: the pixel of the last estimate, no covariance.
+    const double fold_r2 = camera.distortion_fold_r2();
+    for (const Vec3& p : points) {
+      const Vec3 pc = pose.T * p;
+      ProjectedVertex& v = start_vertex(out, pc.z(), shared, o);
+      if (v.flags.behind_camera) continue;
+      v.mean_px = camera.project(pc);
+      v.flags.past_distortion_fold = pc.head<2>().squaredNorm() >= fold_r2 * pc.z() * pc.z();
+    }
   }
+  // A NaN compares false with every bound above (a NaN depth is not behind the camera),
+  // so non-finite numbers, from the input or from an overflow, are caught in the results:
+  // in one sum per vertex, which a NaN or an infinity (or numbers near the largest double,
+  // whose sum overflows) makes non-finite.
+  for (ProjectedVertex& v : out)
+    v.flags.not_finite =
+        !std::isfinite(v.depth_m + v.depth_sigma_m + v.mean_px.sum() + v.covariance_px2.sum());
 }
 
 std::vector<ProjectedVertex> project_vertices(const Camera& camera, const UncertainPose& pose,

@@ -488,6 +488,10 @@ void expand_region(std::span<const ProjectedVertex> vertices, std::span<const in
   pending.push_back(first);
   for (int k = 7; k >= 1; --k) pending.push_back(ellipses.support(kInitial[k]));
   SupportLine current = first;
+  // Each split adds a line and, in the end, a corner, so the corners' cap bounds the splits
+  // too, except where corners coincide or are not numbers (supports that overflowed): the
+  // splits are bounded as well, or such a set would be split down to kSmallestGap.
+  int splits = 0;
   while (!pending.empty()) {
     const SupportLine& next = pending.back();
     const Vec2 q = corner(current.normal, current.offset, next.normal, next.offset);
@@ -503,7 +507,8 @@ void expand_region(std::span<const ProjectedVertex> vertices, std::span<const in
                                 .squaredNorm());
     const bool loose = gap2 > tolerance2;
     if (loose && cross(current.normal, next.normal) > kSmallestGap &&
-        static_cast<int>(outer.size() + pending.size()) < o.max_outer_corners) {
+        static_cast<int>(outer.size() + pending.size()) < o.max_outer_corners && splits < 2 * o.max_outer_corners) {
+      ++splits;
       pending.push_back(ellipses.support(split_direction(current, next)));
       continue;
     }

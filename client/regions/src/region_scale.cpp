@@ -154,8 +154,10 @@ double whole_object_scale2(const Camera& camera, const UncertainPose& pose,
   }
   const double s2 = 2 * std::log(std::max(length, 2 * std::numbers::pi) / (2 * std::numbers::pi)) + per_vertex;
   // Never beyond the bound that holds for every point at once: the 6-D confidence
-  // ellipsoid of the pose maps inside every point's ellipse at that scale.
-  return std::min(s2, chi2_6_quantile(confidence));
+  // ellipsoid of the pose maps inside every point's ellipse at that scale. That bound too
+  // where the length is not a number (a pose covariance far from positive semi-definite).
+  const double every_point = chi2_6_quantile(confidence);
+  return std::isnan(s2) ? every_point : std::min(s2, every_point);
 }
 
 }  // namespace covtrack::client

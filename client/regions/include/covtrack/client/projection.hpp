@@ -96,6 +96,9 @@ struct ProjectionFlags {
   // The vertex, or one of its sigma points, lies past the lens model's distortion fold
   // (Camera::distortion_fold_r2): its pixel is not where the point appears.
   bool past_distortion_fold = false;
+  // A NaN or an infinity in the pose, its covariance or the vertex, or numbers so large
+  // that the pixel or its covariance overflowed: the vertex has no pixel.
+  bool not_finite = false;
   // The vertex's depth spread along the line of sight is a large fraction of its depth
   // (ProjectionOptions::max_depth_sigma_ratio): the ellipse is an approximation to doubt.
   // A warning: the regions are still computed.
@@ -103,11 +106,11 @@ struct ProjectionFlags {
 
   // The mean and covariance describe the vertex (the other flags are warnings).
   bool usable() const {
-    return !behind_camera && !sigma_point_behind_camera && !unbounded && !past_distortion_fold;
+    return !behind_camera && !sigma_point_behind_camera && !unbounded && !past_distortion_fold && !not_finite;
   }
   bool any() const {
     return behind_camera || sigma_point_behind_camera || rotation_too_uncertain ||
-           unbounded || covariance_repaired || past_distortion_fold || depth_nonlinear;
+           unbounded || covariance_repaired || past_distortion_fold || not_finite || depth_nonlinear;
   }
   // Inline: it runs for every vertex of every object, and a call cost more than the ors.
   ProjectionFlags& operator|=(const ProjectionFlags& o) {
@@ -117,6 +120,7 @@ struct ProjectionFlags {
     unbounded |= o.unbounded;
     covariance_repaired |= o.covariance_repaired;
     past_distortion_fold |= o.past_distortion_fold;
+    not_finite |= o.not_finite;
     depth_nonlinear |= o.depth_nonlinear;
     return *this;
   }

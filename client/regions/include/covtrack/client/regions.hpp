@@ -118,7 +118,8 @@ struct ObjectRegions {
   double outer_scale = 0;
   Polygon inner;                          // empty when !valid or swamped by the error
   double assessment = 0;                  // of the hull vertices; +inf when !valid
-  ProjectionFlags flags;                  // OR over all vertices
+  // OR over all vertices; not_finite also where the regions themselves overflowed.
+  ProjectionFlags flags;
   // Every vertex usable (in front of the camera under all sigma points, bounded pose):
   // only then do the regions mean anything.
   bool valid = false;
