@@ -8,7 +8,7 @@ namespace covtrack::client {
 namespace {
 // Every coordinate finite, in one sum (a sum that overflows flags numbers near the
 // largest double too): checked for every object of every frame, so summed as one array,
-// which Eigen does in vector registers (a loop of dependent additions cost 4% a frame).
+// which Eigen does in vector registers.
 bool finite_sum(const Polygon& polygon) {
   if (polygon.empty()) return true;
   return std::isfinite(Eigen::Map<const Eigen::VectorXd>(polygon.data()->data(), 2 * polygon.size()).sum());

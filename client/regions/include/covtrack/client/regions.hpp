@@ -120,8 +120,8 @@ struct ObjectRegions {
   double assessment = 0;                  // of the hull vertices; +inf when !valid
   // OR over all vertices; not_finite also where the regions themselves overflowed.
   ProjectionFlags flags;
-  // Every vertex usable (in front of the camera under all sigma points, bounded pose):
-  // only then do the regions mean anything.
+  // Every vertex usable (in front of the camera under all sigma points, bounded pose,
+  // finite numbers) and the regions finite: only then do the regions mean anything.
   bool valid = false;
 };
 
