@@ -505,7 +505,9 @@ TEST(Regions, InvalidAndFlaggedWhenNumbersAreNotFinite) {
       o.projection.method = method;
       const ObjectRegions r = compute_object_regions(cam, pose, vertices, o);
       EXPECT_FALSE(r.valid) << what;
-      if (std::ranges::find(methods, method) != methods.end()) EXPECT_TRUE(r.flags.not_finite) << what;
+      if (std::ranges::find(methods, method) != methods.end()) {
+        EXPECT_TRUE(r.flags.not_finite) << what;
+      }
       EXPECT_TRUE(r.outer.empty() && r.inner.empty()) << what;
       EXPECT_TRUE(std::isinf(r.assessment)) << what;
     }

@@ -13,6 +13,16 @@ bool finite_sum(const Polygon& polygon) {
   if (polygon.empty()) return true;
   return std::isfinite(Eigen::Map<const Eigen::VectorXd>(polygon.data()->data(), 2 * polygon.size()).sum());
 }
+
+// An object whose regions mean nothing: none, and the assessment that says so.
+void no_regions(ObjectRegions& r) {
+  r.valid = false;
+  r.outer.clear();
+  r.inner.clear();
+  r.hull.clear();
+  r.outer_scale = 0;
+  r.assessment = std::numeric_limits<double>::infinity();
+}
 }  // namespace
 
 void compute_object_regions(const Camera& camera, const UncertainPose& T_camera_object,
@@ -25,14 +35,7 @@ void compute_object_regions(const Camera& camera, const UncertainPose& T_camera_
     r.flags |= v.flags;
     r.valid = r.valid && v.flags.usable();
   }
-  r.outer.clear();
-  r.inner.clear();
-  r.outer_scale = 0;
-  if (!r.valid) {
-    r.hull.clear();
-    r.assessment = std::numeric_limits<double>::infinity();
-    return;
-  }
+  if (!r.valid) return no_regions(r);
 
   // Scratch kept per thread: a frame of many objects allocates nothing. The hull's buffer
   // is taken out of its pool while in use, because the assessment runs user code that
@@ -70,12 +73,7 @@ void compute_object_regions(const Camera& camera, const UncertainPose& T_camera_
   // no regions, flagged as a non-finite input is.
   if (!(finite_sum(r.outer) && finite_sum(r.inner) && std::isfinite(r.outer_scale))) {
     r.flags.not_finite = true;
-    r.valid = false;
-    r.outer.clear();
-    r.inner.clear();
-    r.hull.clear();
-    r.outer_scale = 0;
-    r.assessment = std::numeric_limits<double>::infinity();
+    no_regions(r);
   }
 }
 
