@@ -347,6 +347,11 @@ TEST(Projection, BlocksGiveWhatEachVertexGetsAlone) {
     const Mat2 expected = J * coupled.covariance * J.transpose();
     EXPECT_LT(relative_frobenius(first_order[k].covariance_px2, expected), 1e-12) << "vertex " << k;
     EXPECT_LT((first_order[k].mean_px - cam.project(pose.T * points[k])).norm(), 1e-9) << "vertex " << k;
+    // The depth's row: R's third row times [I, -skew(p)].
+    Eigen::Matrix<double, 1, 6> Jz;
+    Jz << coupled.T.linear().row(2), -coupled.T.linear().row(2) * skew(points[k]);
+    const double depth_sigma = std::sqrt((Jz * coupled.covariance * Jz.transpose())(0, 0));
+    EXPECT_NEAR(first_order[k].depth_sigma_m, depth_sigma, 1e-12 * depth_sigma) << "vertex " << k;
   }
   // And what the unscented transform gives, block by block.
   ProjectionOptions o;

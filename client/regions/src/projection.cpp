@@ -269,13 +269,22 @@ void linear_block(const Camera& camera, const Pose& T, const Mat6& covariance,
                   const double (&px)[kBlock], const double (&py)[kBlock],
                   const double (&pz)[kBlock], LinearBlock& out) {
   const Camera cam = camera;  // local copies: stores through `out` cannot change them
-  double R[9], t[3], C[36];
+  double R[9], t[3];
   for (int r = 0; r < 3; ++r) {
     for (int k = 0; k < 3; ++k) R[3 * r + k] = T.linear()(r, k);
     t[r] = T.translation()[r];
   }
-  for (int a = 0; a < 6; ++a)
-    for (int b = 0; b < 6; ++b) C[6 * a + b] = covariance(a, b);
+  // The covariance's blocks for xi = (rho, phi), symmetrised: translation tt (upper
+  // triangle: 00 01 02 11 12 22), rotation rr (the same), and translation by rotation tr.
+  double tt[6], rr[6], tr[3][3];
+  constexpr int kUpper[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+  for (int e = 0; e < 6; ++e) {
+    const int a = kUpper[e][0], b = kUpper[e][1];
+    tt[e] = 0.5 * (covariance(a, b) + covariance(b, a));
+    rr[e] = 0.5 * (covariance(3 + a, 3 + b) + covariance(3 + b, 3 + a));
+  }
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) tr[a][b] = 0.5 * (covariance(a, 3 + b) + covariance(3 + b, a));
   for (int j = 0; j < kBlock; ++j) {
     const double x = R[0] * px[j] + R[1] * py[j] + R[2] * pz[j] + t[0];
     const double y = R[3] * px[j] + R[4] * py[j] + R[5] * pz[j] + t[1];
@@ -283,40 +292,49 @@ void linear_block(const Camera& camera, const Pose& T, const Mat6& covariance,
     const double iz = 1 / z, xn = x * iz, yn = y * iz;
     double d[4], u, v;
     cam.pixel_of_normalised(xn, yn, u, v, d);
-    // d(pixel)/d(camera point) = d(pixel)/d(xn, yn) [iz 0 -xn iz; 0 iz -yn iz], then times R.
+    // The point's covariance in the object frame, P = G C G^T for G = [I, -K], K = skew(p)
+    // (3x3, then the pixel's rows against it: about 100 products per vertex, where the
+    // 2x6 Jacobian against C took 170): P = tt + tr K + (tr K)^T + K^T rr K, as K^T = -K.
+    // Row a of tr K is (row a of tr) x p; K^T (rr K) = -K (rr K) has as its columns
+    // (rr K)'s crossed with p again.
+    const double p[3] = {px[j], py[j], pz[j]};
+    const auto cross_p = [&](const double (&w)[3], double (&out3)[3]) {
+      out3[0] = w[1] * p[2] - w[2] * p[1], out3[1] = w[2] * p[0] - w[0] * p[2], out3[2] = w[0] * p[1] - w[1] * p[0];
+    };
+    double trK[3][3], rrK[3][3];  // rows: tr_a x p and rr_a x p (= (rr K)_a)
+    const double rr_rows[3][3] = {{rr[0], rr[1], rr[2]}, {rr[1], rr[3], rr[4]}, {rr[2], rr[4], rr[5]}};
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; ++a) cross_p(tr[a], trK[a]), cross_p(rr_rows[a], rrK[a]);
+    // K^T (rr K) = -K (rr K): column b is (column b of rr K) x p.
+    const double col0[3] = {rrK[0][0], rrK[1][0], rrK[2][0]}, col1[3] = {rrK[0][1], rrK[1][1], rrK[2][1]},
+                 col2[3] = {rrK[0][2], rrK[1][2], rrK[2][2]};
+    double k0[3], k1[3], k2[3];
+    cross_p(col0, k0), cross_p(col1, k1), cross_p(col2, k2);
+    const double P00 = tt[0] + 2 * trK[0][0] + k0[0], P01 = tt[1] + trK[0][1] + trK[1][0] + k1[0],
+                 P02 = tt[2] + trK[0][2] + trK[2][0] + k2[0], P11 = tt[3] + 2 * trK[1][1] + k1[1],
+                 P12 = tt[4] + trK[1][2] + trK[2][1] + k2[1], P22 = tt[5] + 2 * trK[2][2] + k2[2];
+    // d(pixel)/d(camera point) = d(pixel)/d(xn, yn) [iz 0 -xn iz; 0 iz -yn iz], times R:
+    // rows w0, w1 of the pixel's derivative by the object-frame point; the depth's is R's
+    // third row.
     const double c[2][3] = {{d[0] * iz, d[1] * iz, -(d[0] * xn + d[1] * yn) * iz},
                             {d[2] * iz, d[3] * iz, -(d[2] * xn + d[3] * yn) * iz}};
-    double J[2][6];
+    double w[3][3];
 #pragma GCC unroll 2
-    for (int r = 0; r < 2; ++r) {
+    for (int r = 0; r < 2; ++r)
 #pragma GCC unroll 3
-      for (int k = 0; k < 3; ++k) J[r][k] = c[r][0] * R[k] + c[r][1] * R[3 + k] + c[r][2] * R[6 + k];
-      // -(row x p): the rotation part, row [-skew(p)] applied from the left.
-      J[r][3] = py[j] * J[r][2] - pz[j] * J[r][1];
-      J[r][4] = pz[j] * J[r][0] - px[j] * J[r][2];
-      J[r][5] = px[j] * J[r][1] - py[j] * J[r][0];
+      for (int k = 0; k < 3; ++k) w[r][k] = c[r][0] * R[k] + c[r][1] * R[3 + k] + c[r][2] * R[6 + k];
+    w[2][0] = R[6], w[2][1] = R[7], w[2][2] = R[8];
+    double Pw[3][3];
+#pragma GCC unroll 3
+    for (int r = 0; r < 3; ++r) {
+      Pw[r][0] = P00 * w[r][0] + P01 * w[r][1] + P02 * w[r][2];
+      Pw[r][1] = P01 * w[r][0] + P11 * w[r][1] + P12 * w[r][2];
+      Pw[r][2] = P02 * w[r][0] + P12 * w[r][1] + P22 * w[r][2];
     }
-    double CJ0[6], CJ1[6];
-#pragma GCC unroll 6
-    for (int a = 0; a < 6; ++a) {
-      CJ0[a] = 0, CJ1[a] = 0;
-#pragma GCC unroll 6
-      for (int b = 0; b < 6; ++b) CJ0[a] += C[6 * a + b] * J[0][b], CJ1[a] += C[6 * a + b] * J[1][b];
-    }
-    double uu = 0, uv = 0, vv = 0;
-#pragma GCC unroll 6
-    for (int a = 0; a < 6; ++a) uu += J[0][a] * CJ0[a], uv += J[0][a] * CJ1[a], vv += J[1][a] * CJ1[a];
-    // The depth's row, R's third row times [I, -skew(p)], and its variance.
-    const double Jz[6] = {R[6], R[7], R[8], py[j] * R[8] - pz[j] * R[7], pz[j] * R[6] - px[j] * R[8],
-                          px[j] * R[7] - py[j] * R[6]};
-    double zz = 0;
-#pragma GCC unroll 6
-    for (int a = 0; a < 6; ++a)
-#pragma GCC unroll 6
-      for (int b = 0; b < 6; ++b) zz += Jz[a] * C[6 * a + b] * Jz[b];
-    out.zvar[j] = zz;
+    const auto dot3 = [](const double (&a)[3], const double (&b)[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+    out.zvar[j] = dot3(w[2], Pw[2]);
     out.u[j] = u, out.v[j] = v, out.z[j] = z, out.r2[j] = xn * xn + yn * yn;
-    out.cuu[j] = uu, out.cuv[j] = uv, out.cvv[j] = vv;
+    out.cuu[j] = dot3(w[0], Pw[0]), out.cuv[j] = dot3(w[0], Pw[1]), out.cvv[j] = dot3(w[1], Pw[1]);
   }
 }
 

@@ -25,17 +25,24 @@ inline double angle_at_most(double y, double x) {
   const double r = std::sqrt(x * x + y * y);
   // t = y / (r + x) = (r - x) / y, the first where x >= 0, the second (capped: y may be 0,
   // opposite directions, pi) where x < 0: neither divides by a small difference.
-  const double t = x >= 0 ? y / std::max(r + x, 1e-300) : std::min((r - x) / y, 1e300);
-  const double half = t <= 1 ? t / (1 + 0.28125 * t * t) : std::numbers::pi / 2 - t / (t * t + 0.28125);
+  // One division for either form (a vector computes both sides of a choice).
+  const bool ahead = x >= 0;
+  const double t = std::min((ahead ? y : r - x) / (ahead ? std::max(r + x, 1e-300) : y), 1e300);
+  const bool small = t <= 1;
+  const double q = t / (small ? 1 + 0.28125 * t * t : t * t + 0.28125);
+  const double half = small ? q : std::numbers::pi / 2 - q;
   return std::min(2 * (half + 0.005), std::numbers::pi);
 }
 
 // A block of hull edges: lane l holds hull vertex first + l (cyclic) and the edge that
 // starts there; lane kLanes only the last edge's end. Per vertex the object point, the
 // pixel covariance (xx, xy, yy) and the outward normal of its edge; then M, the pixel's
-// derivative by the object-frame point (2x3, rows m0, m1). Fixed arrays, so that the
-// compiler sees that they do not overlap.
+// derivative by the object-frame point (2x3, rows m0, m1). The pose (covariance C, row-
+// major; rotation R, translation t) and the focal lengths too: members of one struct, so
+// that the compiler sees that no store into a lane's arrays changes them, and vectorises
+// without checks for overlap (it gives up on too many of them).
 struct EdgeBlock {
+  double C[36], R[9], t[3], fx, fy;
   double px[kLanes + 1], py[kLanes + 1], pz[kLanes + 1], sxx[kLanes + 1], sxy[kLanes + 1], syy[kLanes + 1];
   double u[kLanes + 2], v[kLanes + 2];  // mean pixels, one more: the normal of lane kLanes's edge
   double nx[kLanes + 1], ny[kLanes + 1];
@@ -47,8 +54,8 @@ struct EdgeBlock {
 // the pinhole's, up to a factor per vertex (1 / depth), which no angle depends on; the
 // lens's distortion bends directions only by its local anisotropy, small inside its fold.
 COVTRACK_VECTOR_CLONES
-void edge_lengths(const double (&C)[36], const double (&R)[9], const double (&t)[3], double fx, double fy,
-                  EdgeBlock& h) {
+void edge_lengths(EdgeBlock& h) {
+  const double(&C)[36] = h.C, (&R)[9] = h.R, (&t)[3] = h.t, fx = h.fx, fy = h.fy;
   for (std::size_t l = 0; l <= kLanes; ++l) {
     const double du = h.u[l + 1] - h.u[l], dv = h.v[l + 1] - h.v[l], d2 = du * du + dv * dv;
     const double inverse = d2 > 0 ? 1 / std::sqrt(d2) : 0.0;  // no edge: no normal, no angle
@@ -129,15 +136,14 @@ double whole_object_scale2(const Camera& camera, const UncertainPose& pose,
   const double per_vertex = std::pow(confidence_scale(confidence), 2);  // chi2_2(p)
   const std::size_t k = mean_hull.size();
   if (k < 2) return per_vertex;  // one point: the region is its ellipse
-  double C[36];
-  for (int r = 0; r < 6; ++r)
-    for (int c = 0; c < 6; ++c) C[6 * r + c] = pose.covariance(r, c);
-  double R[9], t[3];
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) R[3 * r + c] = pose.T.linear()(r, c);
-    t[r] = pose.T.translation()[r];
-  }
   EdgeBlock h;
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) h.C[6 * r + c] = pose.covariance(r, c);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) h.R[3 * r + c] = pose.T.linear()(r, c);
+    h.t[r] = pose.T.translation()[r];
+  }
+  h.fx = camera.fx, h.fy = camera.fy;
   double length = 0;
   for (std::size_t first = 0; first < k; first += kLanes) {
     for (std::size_t l = 0, i = first % k; l <= kLanes + 1; ++l, i = i + 1 == k ? 0 : i + 1) {
@@ -149,7 +155,7 @@ double whole_object_scale2(const Camera& camera, const UncertainPose& pose,
       const Mat2& S = pv.covariance_px2;
       h.sxx[l] = S(0, 0), h.sxy[l] = 0.5 * (S(0, 1) + S(1, 0)), h.syy[l] = S(1, 1);
     }
-    edge_lengths(C, R, t, camera.fx, camera.fy, h);
+    edge_lengths(h);
     for (std::size_t l = 0; l < kLanes && first + l < k; ++l) length += h.length[l];
   }
   const double s2 = 2 * std::log(std::max(length, 2 * std::numbers::pi) / (2 * std::numbers::pi)) + per_vertex;
