@@ -63,7 +63,7 @@ void edge_lengths(EdgeBlock& h) {
     const double x = R[0] * h.px[l] + R[1] * h.py[l] + R[2] * h.pz[l] + t[0];
     const double y = R[3] * h.px[l] + R[4] * h.py[l] + R[5] * h.pz[l] + t[1];
     const double z = R[6] * h.px[l] + R[7] * h.py[l] + R[8] * h.pz[l] + t[2];
-    const double xn = x / z, yn = y / z;
+    const double iz = 1 / z, xn = x * iz, yn = y * iz;
     h.m00[l] = fx * (R[0] - xn * R[6]), h.m01[l] = fx * (R[1] - xn * R[7]), h.m02[l] = fx * (R[2] - xn * R[8]);
     h.m10[l] = fy * (R[3] - yn * R[6]), h.m11[l] = fy * (R[4] - yn * R[7]), h.m12[l] = fy * (R[5] - yn * R[8]);
   }
