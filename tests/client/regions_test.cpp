@@ -489,6 +489,66 @@ TEST(Regions, InvalidWhenBehindCamera) {
   EXPECT_TRUE(std::isinf(r.assessment));
 }
 
+// The whole-object scale's curve length, against the same length summed edge by edge
+// here: for each hull edge the jump between its two vertices' whitened directions (the
+// angle between J_a^T n and J_b^T n in the pose covariance's metric) and its end vertex's
+// arc from this edge's normal to the next one's (in that vertex's pixel covariance), with
+// exact angles. The library's angles are upper bounds within 0.02 rad, so its length lies
+// in [L, L + 0.04 k]. Hulls of 3 to 22 vertices, so that edges fall on both sides of the
+// library's block boundaries (7 edges a block); an undistorted camera, where its pinhole
+// Jacobians are exact.
+TEST(WholeObjectScale, IsTheCurveLengthSummedEdgeByEdge) {
+  Camera cam = test::example_camera();
+  cam.k1 = cam.k2 = cam.k3 = cam.p1 = cam.p2 = 0;
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Mat6 A;
+  for (int i = 0; i < 36; ++i) A(i / 6, i % 6) = u(rng);
+  const Vec6 scale = (Vec6() << 0.004, 0.004, 0.008, 0.03, 0.03, 0.03).finished();
+  const UncertainPose pose{pose_from(Vec3(0.05, -0.03, 1.2), Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Vec3(1, 0.3, 0.2).normalized()))),
+                           scale.asDiagonal() * (A * A.transpose() + 0.1 * Mat6::Identity()) * scale.asDiagonal(), false};
+  ProjectionOptions o;
+  o.method = ProjectionMethod::linear;
+  o.add_intrinsic_uncertainty = false;
+  const double chi2_2 = std::pow(confidence_scale(0.95), 2);
+  for (int n : {3, 5, 7, 8, 9, 14, 15, 16, 22}) {
+    std::vector<Vec3> points;
+    for (int i = 0; i < n; ++i) {
+      const double a = 2 * std::numbers::pi * i / n;
+      points.emplace_back(0.1 * std::cos(a), 0.07 * std::sin(a), 0.01 * std::sin(3 * a));
+    }
+    const std::vector<ProjectedVertex> projected = project_vertices(cam, pose, points, o);
+    std::vector<Vec2> means;
+    for (const ProjectedVertex& v : projected) means.push_back(v.mean_px);
+    std::vector<int> hull;
+    convex_hull_indices(means, hull);
+    const std::size_t k = hull.size();
+    ASSERT_EQ(k, static_cast<std::size_t>(n)) << "every point of the ring is on the hull";
+    const auto normal = [&](std::size_t e) {  // outward normal of the counter-clockwise edge e
+      const Vec2 d = means[hull[(e + 1) % k]] - means[hull[e]];
+      return Vec2(d.y(), -d.x()).normalized();
+    };
+    double length = 0;
+    for (std::size_t e = 0; e < k; ++e) {
+      const std::size_t f = (e + 1) % k;
+      const Vec2 n_e = normal(e), n_f = normal(f);
+      const Vec6 a = pixel_jacobian_wrt_perturbation(cam, pose.T, points[hull[e]]).transpose() * n_e;
+      const Vec6 b = pixel_jacobian_wrt_perturbation(cam, pose.T, points[hull[f]]).transpose() * n_e;
+      const double aa = a.dot(pose.covariance * a), ab = a.dot(pose.covariance * b), bb = b.dot(pose.covariance * b);
+      const Mat2& S = projected[hull[f]].covariance_px2;
+      const double turn = std::abs(n_e.x() * n_f.y() - n_e.y() * n_f.x());
+      length += std::atan2(std::sqrt(std::max(aa * bb - ab * ab, 0.0)), ab) +
+                std::atan2(std::sqrt(S.determinant()) * turn, n_e.dot(S * n_f));
+    }
+    const double s2 = whole_object_scale2(cam, pose, points, projected, hull, 0.95);
+    ASSERT_LT(s2, chi2_6_quantile(0.95)) << n << " vertices: the cap hides the length";
+    const double library_length = 2 * std::numbers::pi * std::exp((s2 - chi2_2) / 2);
+    std::printf("%2d vertices: length %.4f, the library's %.4f\n", n, length, library_length);
+    EXPECT_GE(library_length, length * (1 - 1e-9)) << n << " vertices";
+    EXPECT_LE(library_length, length + 0.04 * k) << n << " vertices";
+  }
+}
+
 // Numbers no tracker reports, as a damaged message or an application's bug could hand
 // them over: the object is invalid and says why, never a region of NaNs (fuzz_regions
 // found regions of NaNs, and a set of supports that overflowed split for a second).

@@ -15,8 +15,12 @@ namespace covtrack::client {
 namespace {
 
 // Edges solved side by side: loops of fixed length without branches over structure-of-
-// arrays data, which vectorise (vector_clones.hpp), as the projection's blocks do.
+// arrays data, which vectorise (vector_clones.hpp), as the projection's blocks do. A block
+// holds kEdges = kLanes - 1 edges, so that each loop runs over exactly kLanes lanes: with
+// kLanes edges the vertices' loop needed one lane more, done without vectors, and its
+// square root and division waited on each other.
 constexpr std::size_t kLanes = 8;
+constexpr std::size_t kEdges = kLanes - 1;
 
 // An upper bound, within 0.01 rad, of the angle atan2(y, x) in [0, pi] for y >= 0, without
 // trigonometry: 2 atan(t) for the half angle's tangent t, with atan(t) within
@@ -35,8 +39,9 @@ inline double angle_at_most(double y, double x) {
 }
 
 // A block of hull edges: lane l holds hull vertex first + l (cyclic) and the edge that
-// starts there; lane kLanes only the last edge's end. Per vertex the object point, the
-// pixel covariance (xx, xy, yy) and the outward normal of its edge; then M, the pixel's
+// starts there; lane kEdges only the last edge's end (its own edge is computed and not
+// used), and lane kLanes, zero, what that unused edge reads. Per vertex the object point,
+// the pixel covariance (xx, xy, yy) and the outward normal of its edge; then M, the pixel's
 // derivative by the object-frame point (2x3, rows m0, m1). The pose (covariance C, row-
 // major; rotation R, translation t) and the focal lengths too: members of one struct, so
 // that the compiler sees that no store into a lane's arrays changes them, and vectorises
@@ -44,7 +49,7 @@ inline double angle_at_most(double y, double x) {
 struct EdgeBlock {
   double C[36], R[9], t[3], fx, fy;
   double px[kLanes + 1], py[kLanes + 1], pz[kLanes + 1], sxx[kLanes + 1], sxy[kLanes + 1], syy[kLanes + 1];
-  double u[kLanes + 2], v[kLanes + 2];  // mean pixels, one more: the normal of lane kLanes's edge
+  double u[kLanes + 1], v[kLanes + 1];  // mean pixels, one more: the normal of lane kEdges's edge
   double nx[kLanes + 1], ny[kLanes + 1];
   double m00[kLanes + 1], m01[kLanes + 1], m02[kLanes + 1], m10[kLanes + 1], m11[kLanes + 1], m12[kLanes + 1];
   double length[kLanes];
@@ -56,7 +61,7 @@ struct EdgeBlock {
 COVTRACK_VECTOR_CLONES
 void edge_lengths(EdgeBlock& h) {
   const double(&C)[36] = h.C, (&R)[9] = h.R, (&t)[3] = h.t, fx = h.fx, fy = h.fy;
-  for (std::size_t l = 0; l <= kLanes; ++l) {
+  for (std::size_t l = 0; l < kLanes; ++l) {
     const double du = h.u[l + 1] - h.u[l], dv = h.v[l + 1] - h.v[l], d2 = du * du + dv * dv;
     const double inverse = d2 > 0 ? 1 / std::sqrt(d2) : 0.0;  // no edge: no normal, no angle
     h.nx[l] = dv * inverse, h.ny[l] = -du * inverse;
@@ -144,19 +149,21 @@ double whole_object_scale2(const Camera& camera, const UncertainPose& pose,
     h.t[r] = pose.T.translation()[r];
   }
   h.fx = camera.fx, h.fy = camera.fy;
+  for (double* spare : {h.px, h.py, h.pz, h.sxx, h.sxy, h.syy, h.nx, h.ny, h.m00, h.m01, h.m02, h.m10, h.m11, h.m12})
+    spare[kLanes] = 0;
   double length = 0;
-  for (std::size_t first = 0; first < k; first += kLanes) {
-    for (std::size_t l = 0, i = first % k; l <= kLanes + 1; ++l, i = i + 1 == k ? 0 : i + 1) {
+  for (std::size_t first = 0; first < k; first += kEdges) {
+    for (std::size_t l = 0, i = first % k; l <= kLanes; ++l, i = i + 1 == k ? 0 : i + 1) {
       const ProjectedVertex& pv = projected[mean_hull[i]];
       h.u[l] = pv.mean_px.x(), h.v[l] = pv.mean_px.y();
-      if (l > kLanes) break;
+      if (l == kLanes) break;
       const Vec3& p = vertices_object[mean_hull[i]];
       h.px[l] = p.x(), h.py[l] = p.y(), h.pz[l] = p.z();
       const Mat2& S = pv.covariance_px2;
       h.sxx[l] = S(0, 0), h.sxy[l] = 0.5 * (S(0, 1) + S(1, 0)), h.syy[l] = S(1, 1);
     }
     edge_lengths(h);
-    for (std::size_t l = 0; l < kLanes && first + l < k; ++l) length += h.length[l];
+    for (std::size_t l = 0; l < kEdges && first + l < k; ++l) length += h.length[l];
   }
   const double s2 = 2 * std::log(std::max(length, 2 * std::numbers::pi) / (2 * std::numbers::pi)) + per_vertex;
   // Never beyond the bound that holds for every point at once: the 6-D confidence
