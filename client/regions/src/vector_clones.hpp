@@ -6,6 +6,11 @@
 // stays portable. Elsewhere, or built with -DCOVTRACK_NO_VECTOR_CLONES (to test the
 // baseline code on a machine that has AVX2), it is empty and the loops stay plain.
 //
+// A cloned function is not inlined into its caller, so the compiler must see for itself
+// that the loop's stores cannot change what it reads: keep the arrays it reads and writes
+// in one struct, or in local copies. Arrays passed in separately make it give up (more
+// than ten overlap checks), silently: check a new loop with -fopt-info-vec-all.
+//
 // vector_clones_have_avx2() says whether the clones chosen run with AVX2 or more (the
 // x86-64-v3 or v4 clone), for code that pays off only then (and a baseline path to take
 // otherwise).
