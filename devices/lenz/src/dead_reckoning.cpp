@@ -35,17 +35,20 @@ bool DeadReckoner::is_possible_move(const std::vector<bool>& occupied) const {
   return !section_ || classify(occupied) != Move::Impossible;
 }
 
-void DeadReckoner::on_occupancy(const std::optional<std::vector<bool>>& occupied, double t_s) {
+void DeadReckoner::on_occupancy(const std::optional<std::vector<bool>>& occupied, double t_s, double read_late_s) {
   if (!occupied) return lose();
   const auto& occ = *occupied;
   const auto count = std::count(occ.begin(), occ.end(), true);
   if (count == 0) return lose();
   if (section_) {
     const std::size_t here = *section_;
+    const double latency_s = params_.crossing_latency_s + std::max(0.0, read_late_s);
     switch (classify(occ)) {
-      case Move::Ahead: return enter(direction_ > 0 ? layout_.next(here) : layout_.previous(here), direction_, t_s);
+      case Move::Ahead:
+        return enter(direction_ > 0 ? layout_.next(here) : layout_.previous(here), direction_, t_s, latency_s);
       case Move::Stay: return;
-      case Move::Behind: return enter(direction_ > 0 ? layout_.previous(here) : layout_.next(here), -direction_, t_s);
+      case Move::Behind:
+        return enter(direction_ > 0 ? layout_.previous(here) : layout_.next(here), -direction_, t_s, latency_s);
       case Move::Impossible: break;
     }
   }
@@ -57,25 +60,28 @@ void DeadReckoner::on_occupancy(const std::optional<std::vector<bool>>& occupied
   // Two or more occupied: several candidate sections, no estimate until it clears up.
 }
 
-void DeadReckoner::enter(std::size_t section, int direction, double t_s) {
+void DeadReckoner::enter(std::size_t section, int direction, double t_s, double latency_s) {
   // Speed at the boundary from the time since the previous crossing, if that was seen:
   // the whole section's length if the train went through it, nothing if it came back.
-  if (entered_at_s_) entry_speed_ = speed_after(*section_, t_s - *entered_at_s_, direction == direction_);
-  else entry_speed_.reset();
+  if (entered_at_s_)
+    entry_speed_ = speed_after(*section_, t_s - *entered_at_s_, entered_latency_s_, latency_s, direction == direction_);
+  else
+    entry_speed_.reset();
   section_ = section;
   direction_ = direction;
   entered_at_s_ = t_s;
+  entered_latency_s_ = latency_s;
 }
 
-DeadReckoner::SpeedRange DeadReckoner::speed_after(std::size_t section, double traversal_s,
-                                                   bool same_direction) const {
+DeadReckoner::SpeedRange DeadReckoner::speed_after(std::size_t section, double traversal_s, double latency_before_s,
+                                                   double latency_after_s, bool same_direction) const {
   const Train& train = layout_.train();
   const double a = train.max_accel_mps2, v_max = train.max_speed_mps;
   const double distance = same_direction ? layout_.sections()[section].length_m : 0.0;
-  const double L = params_.crossing_latency_s;
-  // Each crossing was detected up to L late, so the true time between them is T +- L;
-  // both bounds below are monotonic or convex in it, so its two ends suffice.
-  const double t_short = std::max(traversal_s - L, 1e-3), t_long = traversal_s + L;
+  // Each crossing was detected up to its latency late, so the true time between them is
+  // T - latency_after to T + latency_before; both bounds below are monotonic or convex
+  // in it, so its two ends suffice.
+  const double t_short = std::max(traversal_s - latency_after_s, 1e-3), t_long = traversal_s + latency_before_s;
   // Highest end speed: accelerating all the way. A train that cannot reverse may also
   // have stood and then accelerated, which caps it at sqrt(2 a d).
   const auto highest = [&](double T) {
@@ -118,11 +124,11 @@ AlongTrack DeadReckoner::estimate(double t_s) const {
   }
   out.state = AlongTrack::State::DeadReckoning;
   const SpeedRange v = entry_speed_.value_or(SpeedRange{0, train.max_speed_mps});
-  const double since = t_s - *entered_at_s_;  // the true time since the crossing is in [since, since + L]
+  const double since = t_s - *entered_at_s_;  // the true time since the crossing is in [since, since + latency]
   // Distances from the boundary crossed, into the section.
   const double a = train.max_accel_mps2;
   double near = train.reversible ? v.lo * since - a * since * since / 2 : min_distance(v.lo, since);
-  double far = max_distance(v.hi, since + params_.crossing_latency_s);
+  double far = max_distance(v.hi, since + entered_latency_s_);
   // Inside the occupied section, as last reported: the report may be up to the latency
   // old, so the train may have gone past the far end (or, reversing, back over the near
   // one) by what it covers in that time.

@@ -7,7 +7,8 @@
 // that slows down or stops, and lets the uncertainty run past the section that is
 // known to be occupied. Here the estimate is the set of positions the train can reach:
 // - the locomotive crossed into the section at a detection time, give or take the
-//   detection latency;
+//   detection latency (the configured one, plus however long the reader was held up
+//   before it looked, when the daemon itself was stalled);
 // - its speed then lies in a range derived from the previous section's length and
 //   traversal time and the train's largest acceleration (a train that averaged v over
 //   T seconds ends between v - aT/2 and v + aT/2, never below 0 nor above v_max);
@@ -42,8 +43,10 @@ class DeadReckoner {
   DeadReckoner(const TrackLayout& layout, DeadReckoningParams params);
 
   // The occupied state of every section (index as in the layout), after any change;
-  // nothing when some section's input is not known yet.
-  void on_occupancy(const std::optional<std::vector<bool>>& occupied, double t_s);
+  // nothing when some section's input is not known yet. `read_late_s`: how much longer
+  // than the configured latency the report may have waited to be read (a reader that
+  // was held up; 0 when it was looking).
+  void on_occupancy(const std::optional<std::vector<bool>>& occupied, double t_s, double read_late_s = 0);
   // Whether the train can have produced this occupancy from where it is thought to be
   // (crossed ahead, stayed, or backed up if it may); true while there is no estimate.
   // A pattern it cannot produce is either missed crossings or a corrupt report.
@@ -58,8 +61,9 @@ class DeadReckoner {
   struct SpeedRange { double lo = 0, hi = 0; };
   enum class Move { Ahead, Stay, Behind, Impossible };
   Move classify(const std::vector<bool>& occupied) const;  // requires section_
-  SpeedRange speed_after(std::size_t section, double traversal_s, bool same_direction) const;
-  void enter(std::size_t section, int direction, double t_s);
+  SpeedRange speed_after(std::size_t section, double traversal_s, double latency_before_s, double latency_after_s,
+                         bool same_direction) const;
+  void enter(std::size_t section, int direction, double t_s, double latency_s);
   void lose();
   double min_distance(double v, double t) const;
   double max_distance(double v, double t) const;
@@ -68,6 +72,7 @@ class DeadReckoner {
   DeadReckoningParams params_;
   std::optional<std::size_t> section_;
   std::optional<double> entered_at_s_;   // detection time of the crossing into section_
+  double entered_latency_s_ = 0;         // how late that detection may have been
   std::optional<SpeedRange> entry_speed_;
   int direction_ = +1;  // +1: in loop order; -1: backwards (reversible layouts only)
   std::size_t inconsistencies_ = 0;

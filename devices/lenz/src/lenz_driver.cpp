@@ -28,6 +28,12 @@ using std::chrono::milliseconds;
 // dropped.
 constexpr double kConfirmTimeout_s = 1.0;
 
+// The reader looks at the port at least this often (it waits for bytes no longer).
+constexpr milliseconds kLongestWait{20};
+// A look this long after the previous one means the reader was held up (the daemon
+// stalled, the machine was swapping): bytes read then may have waited that long.
+constexpr milliseconds kHeldUp = 2 * kLongestWait;
+
 Clock::duration seconds(double s) { return duration_cast<Clock::duration>(duration<double>(s)); }
 
 class LenzDriver final : public Driver {
@@ -82,10 +88,16 @@ class LenzDriver final : public Driver {
     std::uint64_t bytes_since_reply = 0;
     const std::uint64_t bad_frames_at_start = decoder_.counters().bad_frames;
     std::uint8_t buffer[256];
+    auto last_look = clock_.now();
     while (!stop.stop_requested()) {
-      auto got = port.read_some(buffer, clock_.io_timeout(stop, next_sample_, milliseconds(20)));
+      auto got = port.read_some(buffer, clock_.io_timeout(stop, next_sample_, kLongestWait));
       if (!got) return std::unexpected(got.error());
       const auto now = clock_.now();
+      // What is read now arrived after the last look. Normally the read wakes as the bytes
+      // come, and the configured latency covers the rest; after a hold-up a crossing may
+      // have waited the whole time, and the estimate must allow for that.
+      read_late_s_ = now - last_look >= kHeldUp ? duration<double>(now - last_look).count() : 0.0;
+      last_look = now;
       if (*got > 0) {
         last_rx = now;
         bytes_since_reply += *got;
@@ -142,7 +154,8 @@ class LenzDriver final : public Driver {
   // Acts on what the feedback reports did: re-runs the reckoner on a change, counts
   // changes dropped as noise, and keeps the nibbles to ask for again (sent by ask_held).
   void take(const FeedbackConfirmation::Outcome& outcome, SampleSink& sink) {
-    if (outcome.changed) reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_.state()), clock_.now_s());
+    if (outcome.changed)
+      reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_.state()), clock_.now_s(), read_late_s_);
     for (const auto& line : outcome.dropped) sink.count_error(fmt::format("{}: {}", config_.port, line));
     to_ask_.insert(to_ask_.end(), outcome.ask.begin(), outcome.ask.end());
   }
@@ -197,6 +210,7 @@ class LenzDriver final : public Driver {
   DeadReckoner reckoner_;
   FeedbackConfirmation feedback_;
   std::vector<FeedbackRequest> to_ask_;
+  double read_late_s_ = 0;  // how long the bytes being handled may have waited unread
   FrameDecoder decoder_;
   Clock::duration period_;
   Clock::time_point next_sample_;
