@@ -17,6 +17,7 @@
 #include "dead_reckoning.hpp"
 #include "feedback_state.hpp"
 #include "layout_config.hpp"
+#include "support/along_track.hpp"
 #include "train_poses.hpp"
 #include "xpressnet_framing.hpp"
 
@@ -28,15 +29,6 @@ namespace {
 template <class Msg>
 bool decode(const lcmlog::LogEvent& e, Msg& msg) {
   return msg.decode(e.payload.data(), 0, static_cast<int>(e.payload.size())) >= 0;
-}
-
-double nearest_s(const TrackLayout& layout, const Vec3& p) {
-  double best_s = 0, best_d = 1e9;
-  for (double s = 0; s < layout.length_m(); s += 0.001) {
-    const double d = (layout.pose_at(s).translation() - p).squaredNorm();
-    if (d < best_d) best_d = d, best_s = s;
-  }
-  return best_s;
 }
 
 // The driver's receive path without the port: raw bytes in, dead reckoning updated.
@@ -113,7 +105,7 @@ TEST(LenzSession, RawBytesReprocessedGiveTheRecordedPosesAndContainTheTruth) {
       const AlongTrack est = second.reckoner.estimate(truth[next_truth].first * 1e-6);
       if (est.state != AlongTrack::State::DeadReckoning) continue;
       ++checked;
-      const double s_true = nearest_s(*layout, truth[next_truth].second.translation());
+      const double s_true = test::along_track_of(*layout, truth[next_truth].second.translation());
       inside += layout->wrap(s_true - est.lo_s) <= est.hi_s - est.lo_s + 0.001;
     }
     second.feed(raw);
