@@ -118,28 +118,33 @@ class Collector {
   std::map<std::string, std::int64_t> last_sequence_;
 };
 
-// Holds the daemon up (SIGSTOP) for `hold_s` as the locomotive is about to cross into the
-// next section, so that the report of that crossing waits unread; returns when the hold
-// began (seconds, the poses' clock), or nothing if no crossing came within `within_s`.
+// Holds the daemon up (SIGSTOP) for `hold_s` from just before the locomotive crosses into
+// the next section, so that the report of that crossing waits unread; returns when the
+// hold began (seconds, the poses' clock), or nothing if no crossing came within
+// `within_s`. The crossing is predicted from the last two truth samples, from their own
+// times, so truth that reaches this process late on a loaded machine still times it.
 std::optional<double> hold_daemon_up_at_a_crossing(Collector& c, pid_t daemon, const lenz::TrackLayout& layout,
                                                    double hold_s, double within_s) {
   const auto& truth = c.truth["train/loco"];
   const std::int64_t until_us = now_us() + static_cast<std::int64_t>(within_s * 1e6);
-  double last_s = -1;
-  std::int64_t last_us = 0;
+  double last_s = -1, last_t = 0;
   while (now_us() < until_us) {
     c.run_for(0.005);
-    if (truth.empty() || truth.rbegin()->first == last_us) continue;
+    if (truth.empty()) continue;
+    const double t = static_cast<double>(truth.rbegin()->first) * 1e-6;
+    if (t == last_t) continue;
     const double s = test::along_track_of(layout, truth.rbegin()->second.translation());
-    const double to_end = layout.sections()[layout.section_at(s)].end_s() - s;
-    const bool moving = last_s >= 0 && layout.wrap(s - last_s) > 0.002;  // over 0.1 m/s at 50 Hz
-    last_s = s, last_us = truth.rbegin()->first;
-    if (!moving || to_end > 0.015) continue;
-    const double began = static_cast<double>(now_us()) * 1e-6;
+    const double speed = last_s >= 0 ? layout.wrap(s - last_s) / (t - last_t) : 0;
+    last_s = s, last_t = t;
+    if (speed < 0.1) continue;
+    const double crossing_t = t + (layout.sections()[layout.section_at(s)].end_s() - s) / speed;
+    const double now = static_cast<double>(now_us()) * 1e-6;
+    // Far enough ahead to stop the daemon first, near enough that the hold covers it.
+    if (crossing_t < now + 0.02 || crossing_t > now + hold_s / 3) continue;
     kill(daemon, SIGSTOP);
     std::this_thread::sleep_for(std::chrono::duration<double>(hold_s));  // the hold itself, not a wait for a result
     kill(daemon, SIGCONT);
-    return began;
+    return now;
   }
   return std::nullopt;
 }
