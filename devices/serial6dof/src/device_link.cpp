@@ -4,6 +4,10 @@ namespace covtrack::serial6dof {
 
 using namespace std::chrono;
 
+namespace {
+constexpr int kMostReadsAtOnce = 16;  // of 4 KB each: a backlog of seconds at any unit's rate
+}  // namespace
+
 Result<void> DeviceLink::send(std::string_view bytes) {
   const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
   if (publish_raw_) sink_.raw(ByteDirection::ToDevice, data, bytes.size());
@@ -11,7 +15,19 @@ Result<void> DeviceLink::send(std::string_view bytes) {
 }
 
 Result<std::size_t> DeviceLink::read(std::vector<std::uint8_t>& out, milliseconds timeout) {
-  return read_until(out, clock_.now() + timeout);
+  auto n = read_until(out, clock_.now() + timeout);
+  if (!n) return n;
+  // Then whatever else is waiting, without waiting: after a hold-up the backlog can
+  // exceed one read, and the caller times a burst from its newest record, which must be
+  // in it (a split burst would time its first part as if it ended now). An error here
+  // shows again at the next read; the bytes already read are kept.
+  std::size_t total = *n;
+  for (int reads = 1; *n > 0 && reads < kMostReadsAtOnce; ++reads) {
+    n = read_until(out, clock_.now());
+    if (!n) break;
+    total += *n;
+  }
+  return total;
 }
 
 Result<std::size_t> DeviceLink::read_until(std::vector<std::uint8_t>& out, DriverClock::time_point until) {

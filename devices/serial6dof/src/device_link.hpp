@@ -21,7 +21,8 @@ class DeviceLink {
       : port_(port), sink_(sink), publish_raw_(publish_raw), stop_(std::move(stop)), clock_(clock) {}
 
   Result<void> send(std::string_view bytes);
-  // Appends what arrives within `timeout` (0 bytes is not an error) to `out`.
+  // Appends what arrives within `timeout` (0 bytes is not an error) to `out`, and then
+  // all that is already waiting.
   Result<std::size_t> read(std::vector<std::uint8_t>& out, std::chrono::milliseconds timeout);
   // The same, waiting at most until `until` on clock().
   Result<std::size_t> read_until(std::vector<std::uint8_t>& out, DriverClock::time_point until);
