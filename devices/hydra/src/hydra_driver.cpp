@@ -17,6 +17,9 @@ using Clock = DriverClock;
 constexpr std::chrono::milliseconds kReadPoll(20);  // a stop is noticed within this
 // VRPN's experience: a base may need the mode switch repeated; give it this long.
 constexpr double kModeSwitchRetry_s = 2.0;
+// Reports queue in the kernel while the reader is held up (a stalled daemon): hidraw
+// keeps up to 63 per reader (a ring of 64) and drops newer ones once it is full.
+constexpr std::size_t kKernelQueue = 63;
 
 std::string find_hydra_path() {
   std::string path;
@@ -56,7 +59,8 @@ class HydraDriver final : public Driver {
     // Reports that do not parse are no sign of life: only a parsed one feeds the watchdog.
     ValidFrameWatchdog watchdog(config_.no_valid_frames_s, last_report);
     std::uint64_t bad_reports = 0;
-    std::array<std::uint8_t, 64> buffer{};
+    std::array<std::array<std::uint8_t, 64>, kKernelQueue> queued{};  // each read takes all that waits
+    std::array<int, kKernelQueue> queued_size{};
     bool lost = false;
     while (!stop.stop_requested()) {
       const double silent_s = std::chrono::duration<double>(clock_.now() - last_report).count();
@@ -71,7 +75,7 @@ class HydraDriver final : public Driver {
                                 *expired, bad_reports));
       }
       const auto wait = clock_.io_timeout(stop, clock_.now() + kReadPoll, kReadPoll);
-      const int n = hid_read_timeout(dev, buffer.data(), buffer.size(), static_cast<int>(wait.count()));
+      const int n = hid_read_timeout(dev, queued[0].data(), queued[0].size(), static_cast<int>(wait.count()));
       if (n < 0) {
         report_lost(sink);
         return fail("Razer Hydra: device disconnected (controllers reported LOST)");
@@ -83,18 +87,37 @@ class HydraDriver final : public Driver {
         }
         continue;
       }
-      auto report = parse_hydra_report({buffer.data(), static_cast<std::size_t>(n)});
-      if (!report) {
-        ++bad_reports;
-        sink.count_error(report.error().message);
-        continue;
+      queued_size[0] = n;
+      std::size_t count = 1;
+      for (; count < queued.size(); ++count) {  // what else waits, without waiting
+        queued_size[count] = hid_read_timeout(dev, queued[count].data(), queued[count].size(), 0);
+        if (queued_size[count] <= 0) break;  // none left (a disconnect shows at the next read)
       }
-      last_report = clock_.now();
-      watchdog.valid_frame(last_report);
-      lost = false;
-      auto out = stream_.on_report(*report, clock_.now_us());
-      for (const auto& line : out.errors) sink.count_error(line);
-      for (const auto& sample : out.samples) sink.pose(sample);
+      // They were measured one report period apart, the last just now: a shared read
+      // time would put all but the last too late, by up to the hold-up. Unless the
+      // kernel's queue was full: then it dropped the newest, and these are of unknown age.
+      const bool timed = count < kKernelQueue;
+      if (!timed)
+        sink.count_error(fmt::format("Razer Hydra: the reader was held up for {} reports or more and the kernel "
+                                     "dropped the newer ones; the {} it kept are not published, their times unknown",
+                                     kKernelQueue, count));
+      const std::int64_t read_us = clock_.now_us();
+      for (std::size_t k = 0; k < count; ++k) {
+        auto report = parse_hydra_report({queued[k].data(), static_cast<std::size_t>(queued_size[k])});
+        if (!report) {
+          ++bad_reports;
+          sink.count_error(report.error().message);
+          continue;
+        }
+        last_report = clock_.now();
+        watchdog.valid_frame(last_report);
+        if (!timed) continue;
+        lost = false;
+        const auto periods_before_last = static_cast<double>(count - 1 - k);
+        auto out = stream_.on_report(*report, read_us - std::llround(periods_before_last * period_s * 1e6));
+        for (const auto& line : out.errors) sink.count_error(line);
+        for (const auto& sample : out.samples) sink.pose(sample);
+      }
     }
     return {};
   }
