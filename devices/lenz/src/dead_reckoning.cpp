@@ -127,7 +127,12 @@ AlongTrack DeadReckoner::estimate(double t_s) const {
   const double since = t_s - *entered_at_s_;  // the true time since the crossing is in [since, since + latency]
   // Distances from the boundary crossed, into the section.
   const double a = train.max_accel_mps2;
-  double near = train.reversible ? v.lo * since - a * since * since / 2 : min_distance(v.lo, since);
+  // Nearest: braking hardest since the crossing (which increases with the time, so the
+  // shortest time gives it), or for a train that may reverse, braking on into reverse
+  // (concave in the time, so the smaller of its two ends).
+  const auto reversing = [&](double t) { return v.lo * t - a * t * t / 2; };
+  double near = train.reversible ? std::min(reversing(since), reversing(since + entered_latency_s_))
+                                 : min_distance(v.lo, since);
   double far = max_distance(v.hi, since + entered_latency_s_);
   // Inside the occupied section, as last reported: the report may be up to the latency
   // old, so the train may have gone past the far end (or, reversing, back over the near
