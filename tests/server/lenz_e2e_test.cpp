@@ -241,7 +241,8 @@ TEST(LenzEndToEnd, EmulatorDaemonClientWithUnplugAndReplug) {
               inside, paired, most_outside, not_judged, 1e3 * latency_s);
   EXPECT_LE(paired - inside, most_outside);
   // Right after the hold the daemon knows the crossing may have waited unread all that
-  // time (0.3 s, 15 cm of track); told nothing, the first pose is 10+ cm off a 2 cm interval.
+  // time (up to 0.3 s: 15 cm of track at 0.5 m/s); told nothing, its first pose was 13 cm
+  // off a 1.5 cm half-width.
   EXPECT_GT(after_hold, 0);
   EXPECT_EQ(after_hold_inside, after_hold) << "poses in the 0.1 s after the crossing read late by the held-up daemon";
 
