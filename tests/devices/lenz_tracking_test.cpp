@@ -220,6 +220,8 @@ TEST(LenzDeadReckoning, ContainsTheTruthThroughSpeedChangesAndStops) {
   EXPECT_LT(mean_width, mean_section_m);
 }
 
+namespace {
+
 // The short layout with reversible = true.
 Result<TrackLayout> reversible_short_layout() {
   std::ifstream in(std::string(COVTRACK_SOURCE_DIR) + "/tests/data/lenz_short_layout.toml");
@@ -231,11 +233,12 @@ Result<TrackLayout> reversible_short_layout() {
 // Backs up a little each lap.
 const std::vector<SpeedStep> kBackingUpProfile{{0.4, 1}, {0, 0.5}, {-0.3, 0.8}, {0, 0.3}, {0.5, 1.5}, {0.1, 1}, {0, 0.5}};
 
+}  // namespace
+
 TEST(LenzDeadReckoning, AReversibleTrainThatBacksUpIsStillContained) {
   auto loaded = reversible_short_layout();
   ASSERT_TRUE(loaded) << loaded.error().message;
-  const std::vector<SpeedStep>& profile = kBackingUpProfile;
-  const HonestyFigures f = run_simulated(*loaded, profile, 120);
+  const HonestyFigures f = run_simulated(*loaded, kBackingUpProfile, 120);
   ASSERT_GT(f.samples, 5000);
   const double inside = double(f.inside) / f.samples;
   std::printf("reversible: along-track 99%% interval holds the truth %.4f of %d samples; 6-D %.4f; "
@@ -244,7 +247,7 @@ TEST(LenzDeadReckoning, AReversibleTrainThatBacksUpIsStillContained) {
   EXPECT_GE(inside, 0.99);
   EXPECT_EQ(f.inconsistencies, 0u);
   // The same run on the forward-only layout: each backing-up is an inconsistency.
-  const HonestyFigures forward_only = run_simulated(load("tests/data/lenz_short_layout.toml"), profile, 30);
+  const HonestyFigures forward_only = run_simulated(load("tests/data/lenz_short_layout.toml"), kBackingUpProfile, 30);
   EXPECT_GT(forward_only.inconsistencies, 0u);
 }
 
