@@ -10,16 +10,14 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <utility>
-#include <variant>
 #include <vector>
 
 #include "covtrack/protocol/se3.hpp"
-#include "feedback_state.hpp"
 #include "support/along_track.hpp"
+#include "support/occupancy_replay.hpp"
 #include "track_layout.hpp"
-#include "xpressnet_framing.hpp"
-#include "xpressnet_messages.hpp"
 
 namespace covtrack::test {
 
@@ -67,18 +65,13 @@ inline std::vector<Crossing> true_crossings(const lenz::TrackLayout& layout,
 inline std::vector<std::pair<double, std::size_t>> occupancy_reads(const lenz::TrackLayout& layout,
                                                                    const std::vector<RawRead>& raw) {
   std::vector<std::pair<double, std::size_t>> out;
-  lenz::FrameDecoder decoder;
-  lenz::FeedbackState state;
-  for (const auto& read : raw) {
-    for (const auto& frame : decoder.push(read.bytes)) {
-      const auto reply = lenz::interpret_reply(frame);
-      if (!std::holds_alternative<lenz::Feedback>(reply) || !state.apply(std::get<lenz::Feedback>(reply))) continue;
-      const auto occupied = lenz::section_occupancy(layout, state);
-      if (!occupied || std::count(occupied->begin(), occupied->end(), true) != 1) continue;
+  OccupancyReplay replay(layout);
+  for (const auto& read : raw)
+    replay.feed(read.bytes, [&](const std::optional<std::vector<bool>>& occupied) {
+      if (!occupied || std::count(occupied->begin(), occupied->end(), true) != 1) return;
       const auto section = static_cast<std::size_t>(std::find(occupied->begin(), occupied->end(), true) - occupied->begin());
       if (out.empty() || out.back().second != section) out.push_back({static_cast<double>(read.time_us) * 1e-6, section});
-    }
-  }
+    });
   return out;
 }
 

@@ -15,11 +15,10 @@
 #include "covtrack/lcmlog/log_reader.hpp"
 #include "covtrack/protocol/pose_message.hpp"
 #include "dead_reckoning.hpp"
-#include "feedback_state.hpp"
 #include "layout_config.hpp"
 #include "support/along_track.hpp"
+#include "support/occupancy_replay.hpp"
 #include "train_poses.hpp"
-#include "xpressnet_framing.hpp"
 
 using namespace covtrack;
 using namespace covtrack::lenz;
@@ -33,18 +32,12 @@ bool decode(const lcmlog::LogEvent& e, Msg& msg) {
 
 // The driver's receive path without the port: raw bytes in, dead reckoning updated.
 struct Reprocessor {
-  explicit Reprocessor(const TrackLayout& layout) : layout(layout), reckoner(layout, {}) {}
+  explicit Reprocessor(const TrackLayout& layout) : replay(layout), reckoner(layout, {}) {}
   void feed(const raw_bytes_t& raw) {
     if (raw.direction != raw_bytes_t::FROM_DEVICE) return;
-    for (const auto& frame : decoder.push(raw.data)) {
-      const Reply reply = interpret_reply(frame);
-      if (const auto* fb = std::get_if<Feedback>(&reply); fb && feedback.apply(*fb))
-        reckoner.on_occupancy(section_occupancy(layout, feedback), raw.time_us * 1e-6);
-    }
+    replay.feed(raw.data, [&](const auto& occupied) { reckoner.on_occupancy(occupied, raw.time_us * 1e-6); });
   }
-  const TrackLayout& layout;
-  FrameDecoder decoder;
-  FeedbackState feedback;
+  test::OccupancyReplay replay;
   DeadReckoner reckoner;
 };
 
@@ -88,8 +81,8 @@ TEST(LenzSession, RawBytesReprocessedGiveTheRecordedPosesAndContainTheTruth) {
   ASSERT_GT(degraded, 150);
   ASSERT_GT(compared, 150);
   EXPECT_GE(double(agreeing) / compared, 0.95) << agreeing << " of " << compared;
-  EXPECT_GT(first.decoder.counters().frames, 30u);
-  EXPECT_EQ(first.decoder.counters().bad_frames, 0u);
+  EXPECT_GT(first.replay.counters().frames, 30u);
+  EXPECT_EQ(first.replay.counters().bad_frames, 0u);
 
   // Re-estimate at every recorded truth time: the truth inside the 99% interval.
   log->rewind();

@@ -96,18 +96,18 @@ class LenzDriver final : public Driver {
       // What is read now arrived after the last look. Normally the read wakes as the bytes
       // come, and the configured latency covers the rest; after a hold-up a crossing may
       // have waited the whole time, and the estimate must allow for that.
-      read_late_s_ = now - last_look >= kHeldUp ? duration<double>(now - last_look).count() : 0.0;
+      const double read_late_s = now - last_look >= kHeldUp ? duration<double>(now - last_look).count() : 0.0;
       last_look = now;
       if (*got > 0) {
         last_rx = now;
         bytes_since_reply += *got;
         sink.raw(ByteDirection::FromDevice, buffer, *got);
-        if (handle_bytes({buffer, *got}, sink)) {
+        if (handle_bytes({buffer, *got}, read_late_s, sink)) {
           watchdog.valid_frame(now);
           bytes_since_reply = 0;
         }
       }
-      take(feedback_.expire(clock_.now_s()), sink);
+      take(feedback_.expire(clock_.now_s()), 0.0, sink);  // drops only: changes nothing
       if (auto sent = ask_held(port, sink); !sent) return sent;
       if (now - last_rx > seconds(config_.link_timeout_s))
         return fail(fmt::format("serial port {}: interface silent for {:.1f} s (no reply to the status request)",
@@ -153,9 +153,10 @@ class LenzDriver final : public Driver {
 
   // Acts on what the feedback reports did: re-runs the reckoner on a change, counts
   // changes dropped as noise, and keeps the nibbles to ask for again (sent by ask_held).
-  void take(const FeedbackConfirmation::Outcome& outcome, SampleSink& sink) {
+  // `read_late_s`: how long the bytes reported may have waited unread.
+  void take(const FeedbackConfirmation::Outcome& outcome, double read_late_s, SampleSink& sink) {
     if (outcome.changed)
-      reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_.state()), clock_.now_s(), read_late_s_);
+      reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_.state()), clock_.now_s(), read_late_s);
     for (const auto& line : outcome.dropped) sink.count_error(fmt::format("{}: {}", config_.port, line));
     to_ask_.insert(to_ask_.end(), outcome.ask.begin(), outcome.ask.end());
   }
@@ -167,7 +168,7 @@ class LenzDriver final : public Driver {
   }
 
   // Returns whether a status reply came (the sign of life; see session()).
-  bool handle_bytes(std::span<const std::uint8_t> bytes, SampleSink& sink) {
+  bool handle_bytes(std::span<const std::uint8_t> bytes, double read_late_s, SampleSink& sink) {
     bool status_reply = false;
     const FramingCounters before = decoder_.counters();
     const auto frames = decoder_.push(bytes);
@@ -178,7 +179,9 @@ class LenzDriver final : public Driver {
     }
     for (const auto& frame : frames) {
       std::visit(overloaded{
-                     [&](const Feedback& fb) { take(feedback_.apply(fb, reckoner_, clock_.now_s()), sink); },
+                     [&](const Feedback& fb) {
+                       take(feedback_.apply(fb, reckoner_, clock_.now_s()), read_late_s, sink);
+                     },
                      [&](const InterfaceNotice& n) {
                        if (n.code != 0x04 && n.code != 0x07) sink.count_error(describe_notice(n.code));
                      },
@@ -210,7 +213,6 @@ class LenzDriver final : public Driver {
   DeadReckoner reckoner_;
   FeedbackConfirmation feedback_;
   std::vector<FeedbackRequest> to_ask_;
-  double read_late_s_ = 0;  // how long the bytes being handled may have waited unread
   FrameDecoder decoder_;
   Clock::duration period_;
   Clock::time_point next_sample_;
