@@ -9,6 +9,7 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -16,7 +17,9 @@
 
 #include <chrono>
 #include <cstdint>
+#include <span>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "covtrack/devices/serial/device_holders.hpp"
@@ -86,6 +89,36 @@ TEST(SerialTransport, ReadTimesOutWithNoBytes) {
   ASSERT_TRUE(n) << n.error().message;
   EXPECT_EQ(*n, 0u);
   EXPECT_FALSE((*port)->disconnected());
+}
+
+// A backlog bigger than one read (a terminal hands out at most 4 KB per read), as after a
+// hold-up of the daemon: read_waiting takes all of it in one call, in order.
+TEST(SerialTransport, ReadWaitingTakesTheWholeBacklogInOneCall) {
+  auto pty = PseudoTerminal::create();
+  ASSERT_TRUE(pty) << pty.error().message;
+  auto port = SerialPort::open({.path = pty->device_path(), .baud = 115200});
+  ASSERT_TRUE(port) << port.error().message;
+  // 10 KB: as much as the terminal takes at once (it took 11.5 KB here).
+  Bytes backlog(10000);
+  for (std::size_t i = 0; i < backlog.size(); ++i) backlog[i] = static_cast<std::uint8_t>(i * 7 + i / 256);
+  const auto give_up = std::chrono::steady_clock::now() + 5s;
+  for (std::size_t sent = 0; sent < backlog.size(); std::this_thread::yield()) {
+    ASSERT_LT(std::chrono::steady_clock::now(), give_up) << "the terminal took no more after " << sent << " bytes";
+    auto n = pty->write(std::span(backlog).subspan(sent));
+    ASSERT_TRUE(n) << n.error().message;
+    sent += *n;
+  }
+  Bytes got{0xAA};  // appended to, not replaced
+  auto n = (*port)->read_waiting(got, 1000ms);
+  ASSERT_TRUE(n) << n.error().message;
+  EXPECT_EQ(*n, backlog.size());
+  ASSERT_EQ(got.size(), backlog.size() + 1);
+  EXPECT_EQ(got[0], 0xAA);
+  EXPECT_TRUE(std::equal(backlog.begin(), backlog.end(), got.begin() + 1));
+  // Nothing more waiting: a wait that ends with no bytes.
+  n = (*port)->read_waiting(got, 10ms);
+  ASSERT_TRUE(n) << n.error().message;
+  EXPECT_EQ(*n, 0u);
 }
 
 TEST(SerialTransport, MissingDeviceIsAClearError) {
@@ -233,6 +266,10 @@ TEST(SerialTransport, UnplugIsAnErrorAndReplugWorksAgain) {
     ASSERT_FALSE(n) << "read on an unplugged device returned " << *n << " bytes";
     EXPECT_NE(n.error().message.find("disconnected"), std::string::npos) << n.error().message;
     EXPECT_TRUE((*port)->disconnected());
+    // Every later call tells the same reason.
+    auto again = (*port)->read_some(buf, 500ms);
+    ASSERT_FALSE(again);
+    EXPECT_EQ(again.error().message, n.error().message);
     EXPECT_FALSE((*port)->write_all(hello, 100ms));
     // The port is destroyed here, on a dead device: this must not terminate the process.
   }

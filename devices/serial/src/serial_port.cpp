@@ -7,6 +7,7 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -148,7 +149,8 @@ Result<std::unique_ptr<SerialPort>> SerialPort::open(const SerialSettings& setti
 
 Error SerialPort::disconnect_error(const std::string& what) {
   disconnected_ = true;
-  return Error{fmt::format("serial port {}: device disconnected ({})", path_, what)};
+  if (disconnect_reason_.empty()) disconnect_reason_ = what;
+  return Error{fmt::format("serial port {}: device disconnected ({})", path_, disconnect_reason_)};
 }
 
 Result<std::size_t> SerialPort::read_some(std::span<std::uint8_t> buffer, std::chrono::milliseconds timeout) {
@@ -171,6 +173,19 @@ Result<std::size_t> SerialPort::read_some(std::span<std::uint8_t> buffer, std::c
   if (p.revents & POLLHUP) return std::unexpected(disconnect_error("hang-up"));
   if (p.revents & (POLLERR | POLLNVAL)) return std::unexpected(disconnect_error("error on descriptor"));
   return 0;
+}
+
+Result<std::size_t> SerialPort::read_waiting(std::vector<std::uint8_t>& out, std::chrono::milliseconds timeout) {
+  std::uint8_t buffer[4096];
+  std::size_t total = 0;
+  while (total < kMostWaiting) {
+    auto n = read_some({buffer, std::min(sizeof buffer, kMostWaiting - total)}, total ? std::chrono::milliseconds(0) : timeout);
+    if (!n && total == 0) return n;
+    if (!n || *n == 0) break;
+    out.insert(out.end(), buffer, buffer + *n);
+    total += *n;
+  }
+  return total;
 }
 
 Result<void> SerialPort::write_all(std::span<const std::uint8_t> bytes, std::chrono::milliseconds timeout) {

@@ -4,10 +4,6 @@ namespace covtrack::serial6dof {
 
 using namespace std::chrono;
 
-namespace {
-constexpr int kMostReadsAtOnce = 16;  // of 4 KB each: a backlog of seconds at any unit's rate
-}  // namespace
-
 Result<void> DeviceLink::send(std::string_view bytes) {
   const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
   if (publish_raw_) sink_.raw(ByteDirection::ToDevice, data, bytes.size());
@@ -15,27 +11,15 @@ Result<void> DeviceLink::send(std::string_view bytes) {
 }
 
 Result<std::size_t> DeviceLink::read(std::vector<std::uint8_t>& out, milliseconds timeout) {
-  auto n = read_until(out, clock_.now() + timeout);
-  if (!n) return n;
-  // Then whatever else is waiting, without waiting: after a hold-up the backlog can
-  // exceed one read, and the caller times a burst from its newest record, which must be
-  // in it (a split burst would time its first part as if it ended now). An error here
-  // shows again at the next read; the bytes already read are kept.
-  std::size_t total = *n;
-  for (int reads = 1; *n > 0 && reads < kMostReadsAtOnce; ++reads) {
-    n = read_until(out, clock_.now());
-    if (!n) break;
-    total += *n;
-  }
-  return total;
+  return read_until(out, clock_.now() + timeout);
 }
 
 Result<std::size_t> DeviceLink::read_until(std::vector<std::uint8_t>& out, DriverClock::time_point until) {
-  std::uint8_t buffer[4096];
-  auto n = port_.read_some(buffer, clock_.io_timeout(stop_, until, ceil<milliseconds>(until - clock_.now())));
-  if (!n) return n;
-  if (*n && publish_raw_) sink_.raw(ByteDirection::FromDevice, buffer, *n);
-  out.insert(out.end(), buffer, buffer + *n);
+  // All that is waiting, not one read's worth: the caller times a burst of records from
+  // its newest, which must be in it (serial_port.hpp, read_waiting).
+  const std::size_t before = out.size();
+  auto n = port_.read_waiting(out, clock_.io_timeout(stop_, until, ceil<milliseconds>(until - clock_.now())));
+  if (n && *n && publish_raw_) sink_.raw(ByteDirection::FromDevice, out.data() + before, *n);
   return n;
 }
 

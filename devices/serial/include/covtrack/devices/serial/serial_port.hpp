@@ -19,6 +19,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "covtrack/devices/serial/port_lock.hpp"
 #include "covtrack/protocol/result.hpp"
@@ -50,6 +51,15 @@ class SerialPort {
   // bytes on timeout; an error once the device has gone away (hang-up, EOF, EIO).
   Result<std::size_t> read_some(std::span<std::uint8_t> buffer, std::chrono::milliseconds timeout);
 
+  // Appends to `out` what arrives within `timeout`, then everything else already waiting
+  // (up to kMostWaiting bytes), and returns how many bytes it appended. Why: a terminal
+  // hands out at most 4 KB per read, and after a hold-up (the daemon stalled) the backlog
+  // can be larger; a driver that times what it reads by how long it was held up must
+  // see the whole backlog in one read, or it times the rest as if it had just arrived.
+  // A failure after some bytes keeps them and shows at the next call.
+  static constexpr std::size_t kMostWaiting = 64 * 1024;
+  Result<std::size_t> read_waiting(std::vector<std::uint8_t>& out, std::chrono::milliseconds timeout);
+
   // Writes all bytes, waiting at most `timeout` in total for the device to take them.
   Result<void> write_all(std::span<const std::uint8_t> bytes, std::chrono::milliseconds timeout);
 
@@ -67,6 +77,7 @@ class SerialPort {
   std::string path_;
   int fd_ = -1;
   bool disconnected_ = false;
+  std::string disconnect_reason_;  // the first, told again by every later call
 };
 
 }  // namespace covtrack::serial
