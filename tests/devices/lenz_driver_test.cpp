@@ -48,8 +48,38 @@ const std::vector<SpeedStep> kProfile{{0.5, 1.5}, {0.15, 1}, {0, 1}, {0.4, 1.5}}
 // reads it in that step or the next), well within the 50 ms the dead reckoning allows.
 constexpr auto kStep = 5ms;
 
+// A driver's own clock that can hold the driver up once, between its port's answer and its
+// next look at the clock, as when the process is stopped or preempted as its poll returns:
+// the read saw the port as it was before the hold-up, the clock after it.
+class HoldOnTheWayBack final : public DriverClock {
+ public:
+  explicit HoldOnTheWayBack(test::ManualClock& clock) : clock_(clock) {}
+  void hold_after_the_next_wait(duration how_long) { hold_ = how_long; }
+
+  time_point now() const override {
+    if (std::exchange(waited_, false))
+      if (const duration hold = hold_.exchange(duration::zero()); hold > duration::zero()) clock_.advance(hold);
+    return clock_.now();
+  }
+  std::int64_t now_us() const override { return clock_.now_us(); }
+  std::chrono::milliseconds io_timeout(std::stop_token stop, time_point due, std::chrono::milliseconds cap) override {
+    const auto timeout = clock_.io_timeout(stop, due, cap);
+    waited_ = true;
+    return timeout;
+  }
+  bool sleep_until(std::stop_token stop, time_point deadline) override { return clock_.sleep_until(stop, deadline); }
+
+ private:
+  test::ManualClock& clock_;
+  mutable std::atomic<duration> hold_{duration::zero()};  // set by the test, taken by the driver's thread
+  mutable bool waited_ = false;                            // the driver's thread only
+};
+
 struct Rig {
-  explicit Rig(Interface interface, const std::string& name) {
+  // `driver_clock_of_its_own`: the driver's time moves only when the test moves it
+  // (run_both_for), so that the test can hold the driver up while the emulator runs.
+  explicit Rig(Interface interface, const std::string& name, bool driver_clock_of_its_own = false)
+      : driver_clock(driver_clock_of_its_own ? own_driver_clock : clock) {
     LenzEmulatorOptions options;
     options.layout = short_layout();
     options.interface = interface;
@@ -72,19 +102,31 @@ struct Rig {
     config.link_timeout_s = 1.0;
     config.no_valid_frames_s = 1.0;
     config.reconnect_s = 0.1;
-    driver = make_lenz_driver(config, clock);
-    clock.join();
+    driver = make_lenz_driver(config, driver_clock_of_its_own ? static_cast<DriverClock&>(hold_on_the_way_back) : clock);
+    driver_clock.join();
     driver_thread = std::jthread([this](std::stop_token stop) {
       result = driver->run(sink, stop);
       returned = true;
-      clock.leave();
+      driver_clock.leave();
     });
-    EXPECT_TRUE(clock.settle()) << "driver or emulator did not start";
+    EXPECT_TRUE(clock.settle() && driver_clock.settle()) << "driver or emulator did not start";
   }
   ~Rig() {
     driver_thread.request_stop();
     driver_thread.join();
     emulator_thread.request_stop();
+  }
+  // Moves both clocks on together, a step at a time (a driver with a clock of its own).
+  bool run_both_for(std::chrono::nanoseconds how_long) {
+    for (std::chrono::nanoseconds done{0}; done < how_long; done += kStep) {
+      clock.advance(kStep);
+      own_driver_clock.advance(kStep);
+      if (!clock.settle() || !own_driver_clock.settle()) {
+        ADD_FAILURE() << "a loop did not catch up with the simulated clock at " << clock.elapsed_s() << " s";
+        return false;
+      }
+    }
+    return true;
   }
   std::vector<PoseSample> poses() {
     std::lock_guard lock(sink.m);
@@ -95,7 +137,11 @@ struct Rig {
     return sink.raw_bytes;
   }
 
-  test::ManualClock clock{kStep};  // first: outlives the threads that wait on it
+  // First: they outlive the threads that wait on them.
+  test::ManualClock clock{kStep};             // the emulator's, and the driver's unless it has its own
+  test::ManualClock own_driver_clock{kStep};  // unused unless asked for
+  test::ManualClock& driver_clock;
+  HoldOnTheWayBack hold_on_the_way_back{own_driver_clock};  // the driver's, when it has its own
   std::unique_ptr<LenzEmulator> emulator;
   LenzConfig config;
   std::unique_ptr<Driver> driver;
@@ -212,6 +258,80 @@ TEST(LenzDriver, ForgedFeedbackNamingAFarSectionIsAskedAgainAndDropped) {
   EXPECT_GE(rig.sink.errors, forged * 8 / 10);
   EXPECT_LE(rig.sink.errors, forged);
   EXPECT_FALSE(rig.returned) << (rig.result ? "" : rig.result.error().message);
+}
+
+// Hold-ups of the driver in simulated time: the driver runs on its own clock, which the test
+// stops while the emulator's runs on.
+constexpr auto kHold = 300ms;
+
+// Runs both clocks until the locomotive is 20-25 ms before a section boundary at speed (10
+// cm or more in a hold-up): a hold-up that starts now has the crossing in it.
+bool run_to_just_before_a_crossing(Rig& rig) {
+  const TrackLayout& layout = rig.emulator->layout();
+  const auto s_in = [&](std::chrono::milliseconds ahead) {
+    return rig.emulator->true_s_at(rig.clock.now_us() + std::chrono::microseconds(ahead).count());
+  };
+  const auto crossing_within = [&](std::chrono::milliseconds ahead) {
+    return layout.section_at(s_in(ahead)) != layout.section_at(s_in(0ms));
+  };
+  while (rig.clock.elapsed_s() < 2 || !crossing_within(25ms) || crossing_within(20ms) ||
+         layout.wrap(s_in(kHold) - s_in(0ms)) < 0.1) {
+    if (rig.clock.elapsed_s() > 20) {
+      ADD_FAILURE() << "no crossing at speed in 20 s";
+      return false;
+    }
+    if (!rig.run_both_for(kStep)) return false;
+  }
+  return true;
+}
+
+// How the locomotive's poses from `from_us` on hold the truth, 0.1 s on.
+Honesty honesty_after(Rig& rig, std::int64_t from_us) {
+  if (!rig.run_both_for(100ms)) return {};
+  std::vector<PoseSample> after;
+  for (const auto& p : rig.poses())
+    if (p.measurement_time_us >= from_us) after.push_back(p);
+  return honesty_of(after, *rig.emulator);
+}
+
+// The daemon held up (its machine stalled it) while a busy bus queued more than one read's
+// worth of bytes ahead of a crossing. The crossing may have waited the whole hold-up,
+// wherever it lies in the backlog, and the estimate must allow for that.
+TEST(LenzDriver, ACrossingDeepInTheBacklogOfAHoldUpIsAllowedTheWholeHoldUp) {
+  Rig rig(Interface::Li101f, "held", true);
+  ASSERT_TRUE(run_to_just_before_a_crossing(rig));
+  // Another part of the layout reporting inputs that did not change: 100 broadcasts, 400
+  // bytes, of an RS-bus module this layout does not watch (module 91).
+  for (int i = 0; i < 100; ++i) rig.emulator->forge_feedback({90, 0x40});
+  const auto crossings_before = rig.emulator->broadcasts_sent();
+  ASSERT_TRUE(rig.clock.run_for(kHold));  // the driver's clock stands still
+  ASSERT_EQ(rig.emulator->broadcasts_sent(), crossings_before + 1) << "the crossing was not in the hold-up";
+  const std::int64_t hold_end_us = rig.clock.now_us();
+  rig.own_driver_clock.advance(kHold);  // and moves on all at once when the driver runs again
+  ASSERT_TRUE(rig.own_driver_clock.settle());
+  const Honesty h = honesty_after(rig, hold_end_us);
+  ASSERT_GE(h.degraded, 5);
+  EXPECT_EQ(h.inside, h.degraded) << "poses after the hold-up miss the truth: the crossing read late was not allowed for";
+  EXPECT_EQ(rig.sink.errors, 0);
+}
+
+// The driver held up on its way back from a read that found nothing: the read looked
+// before the hold-up, so the crossing that came during it waited the whole hold-up for the
+// next read, and until that read the estimate must allow for a crossing unread that long.
+TEST(LenzDriver, AHoldUpAfterAnEmptyReadIsAllowedForBeforeAndAfterTheNextRead) {
+  Rig rig(Interface::Li101f, "held_after_read", true);
+  ASSERT_TRUE(run_to_just_before_a_crossing(rig));
+  rig.hold_on_the_way_back.hold_after_the_next_wait(kHold);
+  rig.own_driver_clock.advance(kStep);  // the driver reads (the crossing has not come), then is held up
+  ASSERT_TRUE(rig.own_driver_clock.settle());
+  const auto crossings_before = rig.emulator->broadcasts_sent();
+  ASSERT_TRUE(rig.clock.run_for(kStep + kHold));  // the emulator's clock catches up
+  ASSERT_EQ(rig.emulator->broadcasts_sent(), crossings_before + 1) << "the crossing was not in the hold-up";
+  ASSERT_EQ(rig.own_driver_clock.now(), rig.clock.now());
+  const Honesty h = honesty_after(rig, rig.clock.now_us());
+  ASSERT_GE(h.degraded, 5);
+  EXPECT_EQ(h.inside, h.degraded) << "poses after the hold-up miss the truth: the unseen time was not allowed for";
+  EXPECT_EQ(rig.sink.errors, 0);
 }
 
 TEST(LenzDriver, LiUsbPrefixesBothWays) {

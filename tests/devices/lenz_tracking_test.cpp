@@ -300,6 +300,9 @@ TEST(LenzDeadReckoning, FirstReportStopsAndLossAreHandled) {
   // end plus what the train covers within the report latency.
   a = r.estimate(60.0);  // standing for a minute
   EXPECT_LE(a.hi_s, layout.sections()[4].end_s() + layout.train().max_speed_mps * 0.05 + 1e-12);
+  // A reader that has not seen the port for 0.3 s (held up) allows for a crossing out of
+  // the section that long unread.
+  EXPECT_NEAR(r.estimate(60.0, 0.3).hi_s, layout.sections()[4].end_s() + layout.train().max_speed_mps * 0.35, 1e-12);
   EXPECT_NEAR(a.lo_s, layout.sections()[4].start_s, 1e-12);  // could have stopped at once
   // A jump to a section that does not follow: counted, and restarted from there.
   occ[4] = false;

@@ -110,7 +110,7 @@ double DeadReckoner::max_distance(double v, double t) const {
   return v * t_top + a * t_top * t_top / 2 + v_max * (t - t_top);
 }
 
-AlongTrack DeadReckoner::estimate(double t_s) const {
+AlongTrack DeadReckoner::estimate(double t_s, double unseen_s) const {
   AlongTrack out;
   if (!section_) return out;
   const Section& sec = layout_.sections()[*section_];
@@ -135,9 +135,9 @@ AlongTrack DeadReckoner::estimate(double t_s) const {
                                  : min_distance(v.lo, since);
   double far = max_distance(v.hi, since + entered_latency_s_);
   // Inside the occupied section, as last reported: the report may be up to the latency
-  // old, so the train may have gone past the far end (or, reversing, back over the near
-  // one) by what it covers in that time.
-  const double past_end = train.max_speed_mps * params_.crossing_latency_s;
+  // old (and the port unseen longer still), so the train may have gone past the far end
+  // (or, reversing, back over the near one) by what it covers in that time.
+  const double past_end = train.max_speed_mps * (params_.crossing_latency_s + std::max(0.0, unseen_s));
   near = std::clamp(near, train.reversible ? -past_end : 0.0, sec.length_m);
   far = std::clamp(far, near, sec.length_m + past_end);
   if (direction_ > 0) {

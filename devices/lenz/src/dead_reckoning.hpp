@@ -51,7 +51,9 @@ class DeadReckoner {
   // (crossed ahead, stayed, or backed up if it may); true while there is no estimate.
   // A pattern it cannot produce is either missed crossings or a corrupt report.
   bool is_possible_move(const std::vector<bool>& occupied) const;
-  AlongTrack estimate(double t_s) const;
+  // `unseen_s`: how long the reader has not seen the port, when it was held up (0 when it
+  // was looking): a crossing out of the section may have come unread that long too.
+  AlongTrack estimate(double t_s, double unseen_s = 0) const;
   // Forget everything (after a reconnect: crossings may have been missed).
   void reset();
   // Counts of occupancy patterns the train cannot produce (for diagnostics).

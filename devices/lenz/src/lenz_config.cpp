@@ -34,8 +34,8 @@ const TableSpec& lenz_device_spec() {
                             "and restarted (\"no valid frames for N s\")"),
         {"reconnect_s", ValueType::Float, "s", "0.25", "wait between attempts to reopen a lost port", 0.01, 60},
         {"crossing_latency_s", ValueType::Float, "s", "0.05", "a section boundary crossing is reported "
-         "at most this late (command station, interface, serial, scheduling); a driver held up over 40 ms "
-         "(a stalled daemon) adds the hold-up to the crossing it then reads", 0, 5},
+         "at most this late (command station, interface, serial, scheduling); a driver held up over 20 ms "
+         "beyond its waits (a stalled daemon) adds the hold-up to what it then reads", 0, 5},
         {"track_sigma_m", ValueType::Float, "m", "0.003", "error of the track model per axis (rails vs "
          "layout geometry)", 0, 1},
         {"track_sigma_rad", ValueType::Float, "rad", "0.01", "error of a vehicle's attitude on the rails "

@@ -1,9 +1,11 @@
 #include "covtrack/devices/lenz/lenz_driver.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
 #include <set>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -30,9 +32,31 @@ constexpr double kConfirmTimeout_s = 1.0;
 
 // The reader looks at the port at least this often (it waits for bytes no longer).
 constexpr milliseconds kLongestWait{20};
-// A look this long after the previous one means the reader was held up (the daemon
-// stalled, the machine was swapping): bytes read then may have waited that long.
-constexpr milliseconds kHeldUp = 2 * kLongestWait;
+// Time this long beyond the reader's waits means it was held up (the daemon stalled, the
+// machine was swapping): bytes read then may have waited all of it.
+constexpr milliseconds kHeldUp = kLongestWait;
+
+// One read of the port: when it began (asked how long to wait) and how long it would wait.
+struct Look {
+  Clock::time_point from;
+  Clock::duration wait;
+};
+
+// How long bytes read at `now` by `current` may have waited unread, when the reader was
+// held up; 0 when not. They came after `previous` last saw the port, at some moment after
+// it began: an empty read may have looked just before a hold-up that caught it on its
+// way back, so its end says nothing. Normally the two reads' waits account for the span.
+double unread_for_s(const Look& previous, const Look& current, Clock::time_point now) {
+  const auto unseen = now - previous.from;
+  const auto waited = std::min(current.from - previous.from, previous.wait) + std::min(now - current.from, current.wait);
+  return unseen - waited >= kHeldUp ? duration<double>(unseen).count() : 0.0;
+}
+
+// How long the port has gone unseen at `now`, when the reader was held up after `current`
+// began (0 when not): what a read at `now` would find may have waited that long.
+double unseen_for_s(const Look& current, Clock::time_point now) {
+  return unread_for_s(current, Look{now, Clock::duration::zero()}, now);
+}
 
 Clock::duration seconds(double s) { return duration_cast<Clock::duration>(duration<double>(s)); }
 
@@ -87,22 +111,26 @@ class LenzDriver final : public Driver {
     ValidFrameWatchdog watchdog(config_.no_valid_frames_s, clock_.now());
     std::uint64_t bytes_since_reply = 0;
     const std::uint64_t bad_frames_at_start = decoder_.counters().bad_frames;
-    std::uint8_t buffer[256];
-    auto last_look = clock_.now();
+    std::vector<std::uint8_t> buffer;
+    Look previous{clock_.now(), Clock::duration::zero()};
     while (!stop.stop_requested()) {
-      auto got = port.read_some(buffer, clock_.io_timeout(stop, next_sample_, kLongestWait));
+      // All that waits, in one read: after a hold-up every byte of the backlog may have
+      // waited that long, not only the first read's worth.
+      buffer.clear();
+      const Look current{clock_.now(), clock_.io_timeout(stop, next_sample_, kLongestWait)};  // in this order
+      auto got = port.read_waiting(buffer, duration_cast<milliseconds>(current.wait));
       if (!got) return std::unexpected(got.error());
       const auto now = clock_.now();
-      // What is read now arrived after the last look. Normally the read wakes as the bytes
-      // come, and the configured latency covers the rest; after a hold-up a crossing may
-      // have waited the whole time, and the estimate must allow for that.
-      const double read_late_s = now - last_look >= kHeldUp ? duration<double>(now - last_look).count() : 0.0;
-      last_look = now;
+      // Normally the read wakes as the bytes come, and the configured latency covers the
+      // rest; after a hold-up a crossing may have waited the whole time, and the estimate
+      // must allow for that.
+      const double read_late_s = unread_for_s(previous, current, now);
+      previous = current;
       if (*got > 0) {
         last_rx = now;
         bytes_since_reply += *got;
-        sink.raw(ByteDirection::FromDevice, buffer, *got);
-        if (handle_bytes({buffer, *got}, read_late_s, sink)) {
+        sink.raw(ByteDirection::FromDevice, buffer.data(), buffer.size());
+        if (handle_bytes(buffer, read_late_s, sink)) {
           watchdog.valid_frame(now);
           bytes_since_reply = 0;
         }
@@ -123,7 +151,7 @@ class LenzDriver final : public Driver {
         if (auto sent = send(port, sink, CommandStationStatusRequest{}); !sent) return sent;
         next_keepalive = now + seconds(config_.keepalive_s);
       }
-      if (now >= next_sample_) publish(sink, reckoner_.estimate(clock_.now_s()));
+      if (now >= next_sample_) publish(sink, reckoner_.estimate(clock_.now_s(), unseen_for_s(current, now)));
     }
     return {};
   }
