@@ -74,29 +74,14 @@ class Ellipses {
   // Whether every line n_j . x <= h_j holds every ellipse (to rounding); the lines' count a
   // multiple of kLinesBlock. A block of lines at a time, one ellipse after another, so that
   // the block's worst excess stays in registers (a maximum over the ellipses would be a
-  // reduction, which does not vectorise). Blocks of 4: of 8 the baseline clone ran out of
-  // registers (4% slower a frame), and with AVX-512 4 were as fast. No square roots: with
-  // the room r = h + slack - n . c left beyond the centre, the support n . c + sqrt(n'Sn)
-  // fits iff r >= 0 and n'Sn <= r^2.
+  // reduction, which does not vectorise). No square roots: with the room r = h + slack -
+  // n . c left beyond the centre, the support n . c + sqrt(n'Sn) fits iff r >= 0 and
+  // n'Sn <= r^2. The block's lines are vectors of 4 (one register) with AVX2; without it,
+  // two vectors of 2: GCC splits comparisons of vectors wider than the registers into
+  // scalars (region_polygon.cpp), and as plain loops over the block GCC 12 left the AVX2
+  // clone scalar (8% of the first-order frame, measured).
   bool hold_all(std::span<const double> nx, std::span<const double> ny, std::span<const double> h) {
-    for (std::size_t first = 0; first < h.size(); first += kLinesBlock) {
-      double x[kLinesBlock], y[kLinesBlock], limit[kLinesBlock], worst[kLinesBlock];
-      for (std::size_t j = 0; j < kLinesBlock; ++j)
-        x[j] = nx[first + j], y[j] = ny[first + j], limit[j] = with_slack(h[first + j]),
-        worst[j] = -std::numeric_limits<double>::infinity();
-      for (std::size_t i = 0; i < cu_.size(); ++i) {
-        const double u = cu_[i], v = cv_[i], xx = sxx_[i], xy = sxy_[i], yy = syy_[i];
-        for (std::size_t j = 0; j < kLinesBlock; ++j) {
-          const double room = limit[j] - (x[j] * u + y[j] * v);
-          const double spread2 = x[j] * x[j] * xx + 2 * x[j] * y[j] * xy + y[j] * y[j] * yy;
-          worst[j] = std::max(worst[j], room < 0 ? 1.0 : spread2 - room * room);
-        }
-      }
-      bool fits = true;
-      for (std::size_t j = 0; j < kLinesBlock; ++j) fits &= !(worst[j] > 0);
-      if (!fits) return false;
-    }
-    return true;
+    return vector_clones_have_avx2() ? hold_all_in<FourLanes>(nx, ny, h) : hold_all_in<TwoLanes>(nx, ny, h);
   }
 
   // Ellipse i's centre.
@@ -113,6 +98,34 @@ class Ellipses {
   }
 
  private:
+  using TwoLanes = double __attribute__((vector_size(2 * sizeof(double))));
+  using FourLanes = double __attribute__((vector_size(4 * sizeof(double))));
+
+  template <class Lanes>
+  bool hold_all_in(std::span<const double> nx, std::span<const double> ny, std::span<const double> h) {
+    constexpr std::size_t kLanes = sizeof(Lanes) / sizeof(double);
+    constexpr std::size_t kGroups = kLinesBlock / kLanes;
+    const Lanes zero = {}, one = zero + 1;
+    for (std::size_t first = 0; first < h.size(); first += kLinesBlock) {
+      Lanes x[kGroups], y[kGroups], limit[kGroups], worst[kGroups];
+      for (std::size_t j = 0; j < kLinesBlock; ++j)
+        x[j / kLanes][j % kLanes] = nx[first + j], y[j / kLanes][j % kLanes] = ny[first + j],
+                         limit[j / kLanes][j % kLanes] = with_slack(h[first + j]);
+      for (auto& w : worst) w = zero - std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < cu_.size(); ++i)
+        for (std::size_t g = 0; g < kGroups; ++g) {
+          const Lanes room = limit[g] - (x[g] * cu_[i] + y[g] * cv_[i]);
+          const Lanes spread2 = x[g] * x[g] * sxx_[i] + 2 * x[g] * y[g] * sxy_[i] + y[g] * y[g] * syy_[i];
+          const Lanes excess = room < zero ? one : spread2 - room * room;
+          worst[g] = worst[g] < excess ? excess : worst[g];
+        }
+      for (const Lanes& w : worst)
+        for (std::size_t j = 0; j < kLanes; ++j)
+          if (w[j] > 0) return false;
+    }
+    return true;
+  }
+
   std::vector<double> cu_, cv_, sxx_, sxy_, syy_, h_;
 };
 
