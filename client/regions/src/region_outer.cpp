@@ -74,12 +74,13 @@ class Ellipses {
   // Whether every line n_j . x <= h_j holds every ellipse (to rounding); the lines' count a
   // multiple of kLinesBlock. A block of lines at a time, one ellipse after another, so that
   // the block's worst excess stays in registers (a maximum over the ellipses would be a
-  // reduction, which does not vectorise). No square roots: with the room r = h + slack -
-  // n . c left beyond the centre, the support n . c + sqrt(n'Sn) fits iff r >= 0 and
-  // n'Sn <= r^2. The block's lines are vectors of 4 (one register) with AVX2; without it,
-  // two vectors of 2: GCC splits comparisons of vectors wider than the registers into
-  // scalars (region_polygon.cpp), and as plain loops over the block GCC 12 left the AVX2
-  // clone scalar (8% of the first-order frame, measured).
+  // reduction, which does not vectorise). Blocks of 4: of 8 the plain clone ran out of
+  // registers (4% slower a frame), and with AVX-512 4 were as fast. No square roots: with
+  // the room r = h + slack - n . c left beyond the centre, the support n . c + sqrt(n'Sn)
+  // fits iff r >= 0 and n'Sn <= r^2. The block's lines are vectors of 4 (one register)
+  // with AVX2; without it, two vectors of 2: GCC splits comparisons of vectors wider than
+  // the registers into scalars (region_polygon.cpp). As plain loops over the block, GCC 12
+  // left the AVX2 clone scalar (8% of the first-order frame, measured).
   bool hold_all(std::span<const double> nx, std::span<const double> ny, std::span<const double> h) {
     return vector_clones_have_avx2() ? hold_all_in<FourLanes>(nx, ny, h) : hold_all_in<TwoLanes>(nx, ny, h);
   }
@@ -110,7 +111,7 @@ class Ellipses {
       Lanes x[kGroups], y[kGroups], limit[kGroups], worst[kGroups];
       for (std::size_t j = 0; j < kLinesBlock; ++j)
         x[j / kLanes][j % kLanes] = nx[first + j], y[j / kLanes][j % kLanes] = ny[first + j],
-                         limit[j / kLanes][j % kLanes] = with_slack(h[first + j]);
+        limit[j / kLanes][j % kLanes] = with_slack(h[first + j]);
       for (auto& w : worst) w = zero - std::numeric_limits<double>::infinity();
       for (std::size_t i = 0; i < cu_.size(); ++i)
         for (std::size_t g = 0; g < kGroups; ++g) {
