@@ -79,10 +79,10 @@ class Ellipses {
   // the room r = h + slack - n . c left beyond the centre, the support n . c + sqrt(n'Sn)
   // fits iff r >= 0 and n'Sn <= r^2. The block's lines are vectors of 4 (one register)
   // with AVX2; without it, two vectors of 2: GCC splits comparisons of vectors wider than
-  // the registers into scalars (region_polygon.cpp). As plain loops over the block, GCC 12
+  // the registers into scalars (vector_clones.hpp). As plain loops over the block, GCC 12
   // left the AVX2 clone scalar (8% of the first-order frame, measured).
   bool hold_all(std::span<const double> nx, std::span<const double> ny, std::span<const double> h) {
-    return vector_clones_have_avx2() ? hold_all_in<FourLanes>(nx, ny, h) : hold_all_in<TwoLanes>(nx, ny, h);
+    return vector_clones_have_avx2() ? hold_all_in<DoubleLanes4>(nx, ny, h) : hold_all_in<DoubleLanes2>(nx, ny, h);
   }
 
   // Ellipse i's centre.
@@ -99,9 +99,6 @@ class Ellipses {
   }
 
  private:
-  using TwoLanes = double __attribute__((vector_size(2 * sizeof(double))));
-  using FourLanes = double __attribute__((vector_size(4 * sizeof(double))));
-
   template <class Lanes>
   bool hold_all_in(std::span<const double> nx, std::span<const double> ny, std::span<const double> h) {
     constexpr std::size_t kLanes = sizeof(Lanes) / sizeof(double);

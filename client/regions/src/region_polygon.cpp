@@ -18,8 +18,8 @@ constexpr int kFewPoints = 8;
 // Vectors of 4 (AVX2 registers). GCC 12 splits comparisons of vectors wider than the
 // clone's registers into scalars: of 8 even with AVX-512, of 4 in the baseline clone (which
 // therefore sorts instead, see convex_hull_indices). Of 2 it was 5% slower with AVX2.
-using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
-using Mask = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
+using Lanes = DoubleLanes4;
+using Mask = MaskLanes4;
 constexpr int kGroups = kFewPoints / 4;
 
 // For every point i at once (the lanes), the point j seen from i farthest clockwise, and of

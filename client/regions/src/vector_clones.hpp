@@ -14,6 +14,8 @@
 // vector_clones_have_avx2() says whether the clones chosen run with AVX2 or more (the
 // x86-64-v3 or v4 clone), for code that pays off only then (and a baseline path to take
 // otherwise).
+#include <cstdint>
+
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(COVTRACK_NO_VECTOR_CLONES)
 #define COVTRACK_VECTOR_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 inline bool vector_clones_have_avx2() {
@@ -24,3 +26,13 @@ inline bool vector_clones_have_avx2() {
 #define COVTRACK_VECTOR_CLONES
 inline bool vector_clones_have_avx2() { return false; }
 #endif
+
+namespace covtrack::client {
+// GCC vector types, for loops the vectoriser leaves scalar: 2 doubles (a plain x86-64
+// register), 4 (an AVX2 register), and the mask a comparison of 4 gives. GCC 12 splits
+// comparisons of vectors wider than the clone's registers into scalars, so code that
+// compares picks its width by vector_clones_have_avx2().
+using DoubleLanes2 = double __attribute__((vector_size(2 * sizeof(double))));
+using DoubleLanes4 = double __attribute__((vector_size(4 * sizeof(double))));
+using MaskLanes4 = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
+}  // namespace covtrack::client
