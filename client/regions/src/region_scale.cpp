@@ -6,6 +6,7 @@
 #include <numbers>
 #include <vector>
 
+#include "angle_bound.hpp"
 #include "covtrack/client/assessment.hpp"
 #include "covtrack/client/regions.hpp"
 #include "vector_clones.hpp"
@@ -21,22 +22,6 @@ namespace {
 // square root and division waited on each other.
 constexpr std::size_t kLanes = 8;
 constexpr std::size_t kEdges = kLanes - 1;
-
-// An upper bound, within 0.01 rad, of the angle atan2(y, x) in [0, pi] for y >= 0, without
-// trigonometry: 2 atan(t) for the half angle's tangent t, with atan(t) within
-// 0.005 rad of t / (1 + 0.28125 t^2) for t <= 1, of pi/2 - t / (t^2 + 0.28125) beyond.
-inline double angle_at_most(double y, double x) {
-  const double r = std::sqrt(x * x + y * y);
-  // t = y / (r + x) = (r - x) / y, the first where x >= 0, the second (capped: y may be 0,
-  // opposite directions, pi) where x < 0: neither divides by a small difference.
-  // One division for either form (a vector computes both sides of a choice).
-  const bool ahead = x >= 0;
-  const double t = std::min((ahead ? y : r - x) / (ahead ? std::max(r + x, 1e-300) : y), 1e300);
-  const bool small = t <= 1;
-  const double q = t / (small ? 1 + 0.28125 * t * t : t * t + 0.28125);
-  const double half = small ? q : std::numbers::pi / 2 - q;
-  return std::min(2 * (half + 0.005), std::numbers::pi);
-}
 
 // A block of hull edges: lane l holds hull vertex first + l (cyclic) and the edge that
 // starts there; lane kEdges only the last edge's end (its own edge is computed and not
@@ -55,22 +40,22 @@ struct EdgeBlock {
   double length[kLanes];
 };
 
-// Each edge's jump and its end vertex's arc (see whole_object_scale2), into length[e]. M is
-// the pinhole's, up to a factor per vertex (1 / depth), which no angle depends on; the
-// lens's distortion bends directions only by its local anisotropy, small inside its fold.
+// Each edge's jump and its end vertex's arc (see whole_object_scale2), into length[e].
+// Only angles are taken, and no angle changes when a vector is scaled by a positive
+// factor: so the edges' normals are not normalised (a length per edge), and M is the
+// pinhole's times the vertex's depth squared (in front of the camera, so positive),
+// without a division. The lens's distortion bends directions only by its local
+// anisotropy, small inside its fold. No edge (a repeated pixel): a zero normal, angles 0.
 COVTRACK_VECTOR_CLONES
 void edge_lengths(EdgeBlock& h) {
   const double(&C)[36] = h.C, (&R)[9] = h.R, (&t)[3] = h.t, fx = h.fx, fy = h.fy;
   for (std::size_t l = 0; l < kLanes; ++l) {
-    const double du = h.u[l + 1] - h.u[l], dv = h.v[l + 1] - h.v[l], d2 = du * du + dv * dv;
-    const double inverse = d2 > 0 ? 1 / std::sqrt(d2) : 0.0;  // no edge: no normal, no angle
-    h.nx[l] = dv * inverse, h.ny[l] = -du * inverse;
+    h.nx[l] = h.v[l + 1] - h.v[l], h.ny[l] = h.u[l] - h.u[l + 1];
     const double x = R[0] * h.px[l] + R[1] * h.py[l] + R[2] * h.pz[l] + t[0];
     const double y = R[3] * h.px[l] + R[4] * h.py[l] + R[5] * h.pz[l] + t[1];
     const double z = R[6] * h.px[l] + R[7] * h.py[l] + R[8] * h.pz[l] + t[2];
-    const double iz = 1 / z, xn = x * iz, yn = y * iz;
-    h.m00[l] = fx * (R[0] - xn * R[6]), h.m01[l] = fx * (R[1] - xn * R[7]), h.m02[l] = fx * (R[2] - xn * R[8]);
-    h.m10[l] = fy * (R[3] - yn * R[6]), h.m11[l] = fy * (R[4] - yn * R[7]), h.m12[l] = fy * (R[5] - yn * R[8]);
+    h.m00[l] = fx * (z * R[0] - x * R[6]), h.m01[l] = fx * (z * R[1] - x * R[7]), h.m02[l] = fx * (z * R[2] - x * R[8]);
+    h.m10[l] = fy * (z * R[3] - y * R[6]), h.m11[l] = fy * (z * R[4] - y * R[7]), h.m12[l] = fy * (z * R[5] - y * R[8]);
   }
   for (std::size_t e = 0; e < kLanes; ++e) {
     const std::size_t f = e + 1;
