@@ -9,6 +9,12 @@
 // sent within a step may reach the other side in that step or in the next one, as a
 // real line delivers them a little later; a step shorter than the latency a driver
 // allows for keeps that harmless.
+//
+// io_timeout here returns a wait of 0 ms, so a driver that measures how long it was away
+// from its port finds no waits to account for the time between its reads: from one
+// read's start to the next read's end, two steps. The Lenz driver counts 20 ms of that as
+// a hold-up (lenz_driver.cpp, kHeldUp) and widens the poses after it: keep Lenz steps
+// under 10 ms unless a test means a hold-up.
 #include <gtest/gtest.h>
 
 #include <chrono>
