@@ -192,23 +192,50 @@ TEST(LenzEndToEnd, EmulatorDaemonClientWithUnplugAndReplug) {
   // apart: they would measure the machine, not the covariance.
   const auto& truth = c.truth["train/loco"];
   const auto crossings = test::crossing_delays(*layout, truth, c.train_reads);
-  std::vector<double> delays;
-  for (const auto& x : crossings)
-    if (std::isfinite(x.read_s)) delays.push_back(x.delay_s());
+  const auto in_the_hold = [&](const test::Crossing& x) {
+    return held_at_s && x.true_s >= *held_at_s && x.true_s < *held_at_s + 0.3;
+  };
+  // The daemon stalled between a crossing and its read: its 100 Hz simulated device
+  // published nothing for over 40 ms in between.
+  const auto daemon_stalled = [&](const test::Crossing& x) {
+    const auto& steady = c.poses["steady/s0"];
+    for (std::size_t i = 1; i < steady.size(); ++i) {
+      const double before = static_cast<double>(steady[i - 1].time_us) * 1e-6, after = static_cast<double>(steady[i].time_us) * 1e-6;
+      if (before < x.read_s && after > x.true_s && after - before >= test::kEmulatorStall_s) return true;
+    }
+    return false;
+  };
+  // The chain's own delay, over the crossings that neither this test (the hold) nor the
+  // machine (the emulator or the daemon stalled) made late: a CI run on a machine that
+  // stalled its processes read 3 of 6 crossings 0.2-0.37 s late, one of them the hold's,
+  // and failed a median over all of them.
+  std::vector<double> delays, chain_delays;
+  for (const auto& x : crossings) {
+    if (!std::isfinite(x.read_s)) continue;
+    delays.push_back(x.delay_s());
+    if (!x.emulator_stalled && !in_the_hold(x) && !daemon_stalled(x)) chain_delays.push_back(x.delay_s());
+  }
   ASSERT_GE(delays.size(), 5u) << crossings.size() << " crossings in the truth";
   std::sort(delays.begin(), delays.end());
+  std::sort(chain_delays.begin(), chain_delays.end());
   const double latency_s = lenz::DeadReckoningParams{}.crossing_latency_s;
-  std::printf("crossings read by the daemon: %zu, delay median %.1f ms, largest %.1f ms (the model allows %.0f ms)\n",
-              delays.size(), 1e3 * delays[delays.size() / 2], 1e3 * delays.back(), 1e3 * latency_s);
+  std::printf("crossings read by the daemon: %zu, delay median %.1f ms, largest %.1f ms (the model allows %.0f ms); "
+              "%zu with nothing held up\n",
+              delays.size(), 1e3 * delays[delays.size() / 2], 1e3 * delays.back(), 1e3 * latency_s, chain_delays.size());
+  std::printf("each crossing's delay, ms (h: in the hold; e, d: the emulator, the daemon stalled):");
+  for (const auto& x : crossings)
+    std::printf(" %.1f%s%s%s", 1e3 * x.delay_s(), in_the_hold(x) ? "h" : "", x.emulator_stalled ? "e" : "",
+                std::isfinite(x.read_s) && daemon_stalled(x) ? "d" : "");
+  std::printf("\n");
   // The chain itself (emulator, pseudo-terminal, driver) adds a few milliseconds.
-  EXPECT_LT(delays[delays.size() / 2], latency_s / 2);
+  ASSERT_GE(chain_delays.size(), 3u) << "stalls at most crossings: the machine, not the chain, was measured";
+  EXPECT_LT(chain_delays[chain_delays.size() / 2], latency_s / 2);
   // The crossing that came while the daemon was held up was read late.
   ASSERT_TRUE(held_at_s) << "the locomotive reached no section boundary in 3 s";
-  const auto held_crossing = std::find_if(crossings.begin(), crossings.end(), [&](const test::Crossing& x) {
-    return x.true_s >= *held_at_s && x.true_s < *held_at_s + 0.3;
-  });
+  const auto held_crossing = std::find_if(crossings.begin(), crossings.end(), in_the_hold);
   ASSERT_NE(held_crossing, crossings.end()) << "no crossing while the daemon was held up";
   EXPECT_GT(held_crossing->delay_s(), latency_s) << "the crossing came as the daemon was held up";
+  EXPECT_TRUE(daemon_stalled(*held_crossing)) << "the hold is a stall the simulated device shows";
 
   // Honesty through the whole chain: the locomotive's true position (nearest truth
   // sample in time, allowing for the motion in between) inside the 99% interval.
