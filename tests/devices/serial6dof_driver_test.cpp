@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -20,6 +21,7 @@
 #include "covtrack/emulators/serial6dof/emulator.hpp"
 #include "device_model.hpp"
 #include "manual_clock.hpp"
+#include "support/one_percent_bar.hpp"
 
 using namespace covtrack;
 using namespace covtrack::serial6dof;
@@ -127,6 +129,7 @@ struct NeesSummary {
   double mean = 0;
   int n = 0, degraded = 0;
   int outside = 0;  // beyond the 99.9 % quantile of chi-square(6)
+  double largest = 0;
 };
 
 NeesSummary nees(const test::CaptureSink& sink, const Rig& rig) {
@@ -138,6 +141,7 @@ NeesSummary nees(const test::CaptureSink& sink, const Rig& rig) {
     const double nees = e.dot(p.covariance.inverse() * e);
     sum += nees;
     s.outside += nees > 22.458;
+    s.largest = std::max(s.largest, nees);
     ++s.n;
     s.degraded += p.status == TrackingStatus::Degraded;
   }
@@ -186,8 +190,12 @@ INSTANTIATE_TEST_SUITE_P(AllModels, Serial6dofDriverNees,
 
 // A noisy serial line (bits flipped, bytes dropped and doubled in what the unit
 // streams, at the rate of a bad cable: about one record in four touched) must not turn
-// into confident wrong poses: at most 0.1 % of what is published may lie outside its
-// own 99.9 % region, which is what an honest covariance gives on a clean line.
+// into confident wrong poses: no more of what is published may lie outside its own
+// 99.9 % region than an honest covariance puts there on a clean line (at most the count
+// a 0.1 % rate exceeds in 1 % of runs: a bar of 0.1 % of n, its expected count, failed a
+// CI run with 7 of 6,000), and none far out: NEES 100 is 1e-19 of an honest chi-square(6)'s
+// mass, where corrupt records once made poses over 100 sigma off (the largest seen here,
+// the line noise and the machine's load varied: 52).
 class Serial6dofLineNoise : public ::testing::TestWithParam<Model> {};
 
 TEST_P(Serial6dofLineNoise, CorruptRecordsNeverBecomeConfidentPoses) {
@@ -209,11 +217,12 @@ TEST_P(Serial6dofLineNoise, CorruptRecordsNeverBecomeConfidentPoses) {
   std::cout << "[ line noise ] " << model_spec(model).name << ": " << rig.emulator->noise_events()
             << " noise events, " << s.n << " poses published (" << s.degraded << " degraded), "
             << sink.errors << " records dropped, " << s.outside << " outside 99.9%, mean NEES " << s.mean
-            << "\n";
+            << ", largest " << s.largest << "\n";
   ASSERT_GE(s.n, 5000);
   EXPECT_GT(rig.emulator->noise_events(), 1000u) << "the line must be noisy for the test to mean anything";
   EXPECT_GT(sink.errors, 0) << "some records must be dropped";
-  EXPECT_LE(s.outside, 0.001 * s.n);
+  EXPECT_LE(s.outside, test::most_outside(s.n, 0.001));
+  EXPECT_LT(s.largest, 100.0);
 }
 
 TEST(Serial6dofDriver, TheGateDropsNothingFromACleanMovingStream) {
