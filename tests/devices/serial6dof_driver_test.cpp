@@ -193,7 +193,7 @@ INSTANTIATE_TEST_SUITE_P(AllModels, Serial6dofDriverNees,
 // into confident wrong poses: no more of what is published may lie outside its own
 // 99.9 % region than an honest covariance puts there on a clean line (at most the count
 // a 0.1 % rate exceeds in 1 % of runs: a bar of 0.1 % of n, its expected count, failed a
-// CI run with 7 of 6,000), and none far out: NEES 100 is 1e-19 of an honest chi-square(6)'s
+// CI run with 7 of 6,000), and none far out: NEES 100 is 3e-19 of an honest chi-square(6)'s
 // mass, where corrupt records once made poses over 100 sigma off (the largest seen here,
 // the line noise and the machine's load varied: 52).
 class Serial6dofLineNoise : public ::testing::TestWithParam<Model> {};

@@ -43,7 +43,7 @@ struct EdgeBlock {
 // Each edge's jump and its end vertex's arc (see whole_object_scale2), into length[e].
 // Only angles are taken, and no angle changes when a vector is scaled by a positive
 // factor: so the edges' normals are not normalised (a length per edge), and M is the
-// pinhole's times the vertex's depth squared (in front of the camera, so positive),
+// pinhole's times the vertex's depth squared (positive on either side of the camera),
 // without a division. The lens's distortion bends directions only by its local
 // anisotropy, small inside its fold. No edge (a repeated pixel): a zero normal, angles 0.
 COVTRACK_VECTOR_CLONES
