@@ -26,6 +26,7 @@ struct Crossing {
   double true_s = 0;        // when the locomotive's front entered it
   double read_s = INFINITY;  // when the daemon read the report of it (never: infinity)
   bool emulator_stalled = false;  // the emulator was held up as the locomotive crossed
+  bool daemon_stalled = false;    // the daemon was held up before it read it (mark_daemon_stalls)
   double delay_s() const { return read_s - true_s; }
 };
 
@@ -34,8 +35,9 @@ struct RawRead {
   std::vector<std::uint8_t> bytes;
 };
 
-// The emulator publishes its truth every 20 ms; a gap this long means it was held up.
-inline constexpr double kEmulatorStall_s = 0.04;
+// The emulator publishes its truth every 20 ms, the daemon's simulated device every 10 ms;
+// a gap this long in either means that process was held up.
+inline constexpr double kStall_s = 0.04;
 
 // Every section the locomotive entered while the truth ran (travel forwards only, as in
 // the test's profile), its entry time interpolated between the truth samples around it.
@@ -51,7 +53,7 @@ inline std::vector<Crossing> true_crossings(const lenz::TrackLayout& layout,
       const double moved = layout.wrap(s - prev_s);
       const double to_boundary = layout.wrap(layout.sections()[entered].start_s - prev_s);
       Crossing c{entered, prev_t + (t - prev_t) * std::clamp(to_boundary / moved, 0.0, 1.0)};
-      c.emulator_stalled = t - prev_t >= kEmulatorStall_s;
+      c.emulator_stalled = t - prev_t >= kStall_s;
       out.push_back(c);
     }
     first = false;
@@ -88,6 +90,20 @@ inline std::vector<Crossing> crossing_delays(const lenz::TrackLayout& layout, co
         break;
       }
   return crossings;
+}
+
+// Marks the crossings the daemon was held up for: between the crossing and its read (for
+// one never read, any time after it), `stamps_us` (a stream the daemon publishes
+// steadily, in order) has a gap of kStall_s.
+inline void mark_daemon_stalls(std::vector<Crossing>& crossings, const std::vector<std::int64_t>& stamps_us) {
+  for (auto& c : crossings)
+    for (std::size_t i = 1; i < stamps_us.size(); ++i) {
+      const double before = static_cast<double>(stamps_us[i - 1]) * 1e-6, after = static_cast<double>(stamps_us[i]) * 1e-6;
+      if (before < c.read_s && after > c.true_s && after - before >= kStall_s) {
+        c.daemon_stalled = true;
+        break;
+      }
+    }
 }
 
 // Whether the estimate at time t rests on a crossing that the emulator, held up, sent

@@ -191,19 +191,12 @@ TEST(LenzEndToEnd, EmulatorDaemonClientWithUnplugAndReplug) {
   // breaks the model's premise, and the poses resting on such a crossing are counted
   // apart: they would measure the machine, not the covariance.
   const auto& truth = c.truth["train/loco"];
-  const auto crossings = test::crossing_delays(*layout, truth, c.train_reads);
+  auto crossings = test::crossing_delays(*layout, truth, c.train_reads);
+  std::vector<std::int64_t> steady_us;  // the daemon's 100 Hz simulated device
+  for (const auto& s : c.poses["steady/s0"]) steady_us.push_back(s.time_us);
+  test::mark_daemon_stalls(crossings, steady_us);
   const auto in_the_hold = [&](const test::Crossing& x) {
     return held_at_s && x.true_s >= *held_at_s && x.true_s < *held_at_s + 0.3;
-  };
-  // The daemon stalled between a crossing and its read: its 100 Hz simulated device
-  // published nothing for over 40 ms in between.
-  const auto daemon_stalled = [&](const test::Crossing& x) {
-    const auto& steady = c.poses["steady/s0"];
-    for (std::size_t i = 1; i < steady.size(); ++i) {
-      const double before = static_cast<double>(steady[i - 1].time_us) * 1e-6, after = static_cast<double>(steady[i].time_us) * 1e-6;
-      if (before < x.read_s && after > x.true_s && after - before >= test::kEmulatorStall_s) return true;
-    }
-    return false;
   };
   // The chain's own delay, over the crossings that neither this test (the hold) nor the
   // machine (the emulator or the daemon stalled) made late: a CI run on a machine that
@@ -213,7 +206,7 @@ TEST(LenzEndToEnd, EmulatorDaemonClientWithUnplugAndReplug) {
   for (const auto& x : crossings) {
     if (!std::isfinite(x.read_s)) continue;
     delays.push_back(x.delay_s());
-    if (!x.emulator_stalled && !in_the_hold(x) && !daemon_stalled(x)) chain_delays.push_back(x.delay_s());
+    if (!x.emulator_stalled && !x.daemon_stalled && !in_the_hold(x)) chain_delays.push_back(x.delay_s());
   }
   ASSERT_GE(delays.size(), 5u) << crossings.size() << " crossings in the truth";
   std::sort(delays.begin(), delays.end());
@@ -225,7 +218,7 @@ TEST(LenzEndToEnd, EmulatorDaemonClientWithUnplugAndReplug) {
   std::printf("each crossing's delay, ms (h: in the hold; e, d: the emulator, the daemon stalled):");
   for (const auto& x : crossings)
     std::printf(" %.1f%s%s%s", 1e3 * x.delay_s(), in_the_hold(x) ? "h" : "", x.emulator_stalled ? "e" : "",
-                std::isfinite(x.read_s) && daemon_stalled(x) ? "d" : "");
+                std::isfinite(x.read_s) && x.daemon_stalled ? "d" : "");
   std::printf("\n");
   // The chain itself (emulator, pseudo-terminal, driver) adds a few milliseconds.
   ASSERT_GE(chain_delays.size(), 3u) << "stalls at most crossings: the machine, not the chain, was measured";
@@ -235,7 +228,7 @@ TEST(LenzEndToEnd, EmulatorDaemonClientWithUnplugAndReplug) {
   const auto held_crossing = std::find_if(crossings.begin(), crossings.end(), in_the_hold);
   ASSERT_NE(held_crossing, crossings.end()) << "no crossing while the daemon was held up";
   EXPECT_GT(held_crossing->delay_s(), latency_s) << "the crossing came as the daemon was held up";
-  EXPECT_TRUE(daemon_stalled(*held_crossing)) << "the hold is a stall the simulated device shows";
+  EXPECT_TRUE(held_crossing->daemon_stalled) << "the hold is a stall the simulated device shows";
 
   // Honesty through the whole chain: the locomotive's true position (nearest truth
   // sample in time, allowing for the motion in between) inside the 99% interval.
