@@ -1,6 +1,6 @@
 #pragma once
-// The angle bound of the whole-object scale (region_scale.cpp), here so that its test can
-// reach it.
+// The angle bound of the whole-object scale (region_scale.cpp) and of the outer region's
+// arc split (region_outer.cpp), here so that its test can reach it.
 #include <algorithm>
 #include <cmath>
 #include <numbers>

@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 
+#include "angle_bound.hpp"
 #include "covtrack/client/regions.hpp"
 #include "regions_from_tangents.hpp"
 #include "vector_clones.hpp"
@@ -286,14 +287,11 @@ COVTRACK_VECTOR_CLONES
 void block_halvings(ArcBlock& arcs, double tol) {
   constexpr double pi = std::numbers::pi, inf = std::numeric_limits<double>::infinity();
   for (int j = 0; j < kArcs; ++j) {
-    // An upper bound of the arc's angle, without trigonometry: theta = 2 atan(x),
-    // x = cross / (1 + dot), and atan(x) is within 0.005 rad of x / (1 + 0.28125 x^2) for
-    // |x| <= 1 (of pi/2 - x / (x^2 + 0.28125) beyond).
+    // An upper bound of the arc's angle, within 2e-5 rad (meaningless where the arc does
+    // not turn: such an arc is refused below).
     const double cross = arcs.sx[j] * arcs.ey[j] - arcs.sy[j] * arcs.ex[j];
     const double dot = arcs.sx[j] * arcs.ex[j] + arcs.sy[j] * arcs.ey[j];
-    const double x = cross / (1 + dot);
-    const double half = x <= 1 ? x / (1 + 0.28125 * x * x) : pi / 2 - x / (x * x + 0.28125);
-    const double angle2 = 4 * (half + 0.005) * (half + 0.005);
+    const double angle = angle_at_most(cross, dot), angle2 = angle * angle;
     // ratio = (angle / step)^2, with step the widest gap whose corner stays within tol of
     // a circle of the ellipse's largest radius of curvature rho = a^2 / b (semi-axes
     // a >= b): (step / 2)^2 = 2r / (1 + r), r = tol / rho, so ratio = angle^2 (rho + tol) /
