@@ -15,6 +15,9 @@
 #include "covtrack/lcmlog/log_writer.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/pose_message.hpp"
+#include "covtrack/vrpn/message_names.hpp"
+#include "covtrack/vrpn/session.hpp"
+#include "covtrack/vrpn/tracker_report.hpp"
 #include "hydra_report.hpp"
 #include "record_encoder.hpp"
 #include "xpressnet_messages.hpp"
@@ -247,6 +250,24 @@ void regions_seeds() {
   write("regions", "polygons", polygons.bytes);
 }
 
+// What a VRPN client sends covtrackd's VRPN server: its cookie and descriptions, a ping of
+// Tracker0, a tracker report and a UDP description, made by a session of the client's
+// names once it has the server's cookie. The first byte chooses the harness's chunks.
+void vrpn_seeds() {
+  using namespace covtrack::vrpn;
+  Session client({"Tracker0"}, {std::string(kPing), std::string(kTrackerPosQuat)});
+  const Cookie server_cookie = make_cookie();
+  (void)client.receive(server_cookie, 0);
+  const std::int64_t t = 1'700'000'000'000'000;
+  client.send("Tracker0", kPing, t, {});
+  client.send("Tracker0", kTrackerPosQuat, t,
+              encode_pos_quat(report_of(1, pose_from(Vec3(0.1, 0.2, 0.3), Eigen::Quaterniond(0.8, 0.6, 0, 0)))));
+  client.describe_udp("127.0.0.1", 4500, t);
+  Bytes stream{7};
+  append(stream, client.take_output());
+  write("vrpn", "client_handshake_ping_report", stream);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -261,5 +282,6 @@ int main(int argc, char** argv) {
   wire_message_seeds();
   lcm_log_seeds();
   regions_seeds();
+  vrpn_seeds();
   return 0;
 }
