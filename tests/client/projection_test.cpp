@@ -561,11 +561,47 @@ TEST(CameraFile, AnImpossibleImageSizeIsAnErrorNotAnAllocation) {
   EXPECT_NE(cam.error().message.find("2000000000"), std::string::npos) << cam.error().message;
 }
 
+// The intrinsics' standard deviations become a covariance of every pixel: one that is not
+// finite, or negative, is named, not carried into the regions.
+TEST(CameraFile, IntrinsicSigmasMustBeFiniteAndNotNegative) {
+  const std::string head = std::string("%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n") + kMatrix + kDist;
+  const auto with_sigmas = [&](const std::string& name, const std::string& data) {
+    return write_temp(name, head + "intrinsics_std_deviations: !!opencv-matrix\n   rows: 4\n   cols: 1\n"
+                                   "   dt: d\n   data: [ " + data + " ]\n");
+  };
+  const auto fine = load_camera(with_sigmas("covtrack_cam_sigmas.yml", "1.5, 1.5, 0., 2."));
+  ASSERT_TRUE(fine) << fine.error().message;
+  EXPECT_DOUBLE_EQ(fine->intrinsic_sigmas_px[3], 2.0);
+  for (const auto& [name, data, what] : {std::tuple{"covtrack_cam_nan_sigma.yml", ".Nan, 1.5, 1., 1.", "fx is"},
+                                         {"covtrack_cam_inf_sigma.yml", "1.5, .Inf, 1., 1.", "fy is inf"},
+                                         {"covtrack_cam_negative_sigma.yml", "1.5, 1.5, -1., 1.", "cx is -1"}}) {
+    const auto path = with_sigmas(name, data);
+    const auto cam = load_camera(path);
+    ASSERT_FALSE(cam) << data;
+    EXPECT_NE(cam.error().message.find(path.string()), std::string::npos) << cam.error().message;
+    EXPECT_NE(cam.error().message.find(std::string("intrinsics_std_deviations': ") + what), std::string::npos)
+        << cam.error().message;
+  }
+}
+
 TEST(CameraFile, GarbageIsAnErrorNotACrash) {
   const auto path = write_temp("covtrack_cam_garbage.yml", "%YAML:1.0\n---\n[[[ :: not yaml\n");
   const auto cam = load_camera(path);
   ASSERT_FALSE(cam);
   EXPECT_NE(cam.error().message.find(path.string()), std::string::npos);
+}
+
+// OpenCV throws when a key is looked up in a top level that is not a map (a list, a
+// scalar): found by fuzz_camera, where it ended the process.
+TEST(CameraFile, ATopLevelThatIsNotAMapIsAnErrorNotACrash) {
+  for (const auto& [name, text] : {std::pair{"covtrack_cam_list.yml", "%YAML:1.0\n---\n- 1\n- 2\n"},
+                                   {"covtrack_cam_ros_list.yaml", "- image_width\n- 640\n"},
+                                   {"covtrack_cam_scalar.yml", "%YAML:1.0\n---\n640\n"}}) {
+    const auto path = write_temp(name, text);
+    const auto cam = load_camera(path);
+    ASSERT_FALSE(cam) << text;
+    EXPECT_NE(cam.error().message.find(path.string()), std::string::npos) << cam.error().message;
+  }
 }
 
 // ROS's camera_info YAML (what `rosrun camera_calibration` saves): the same camera as

@@ -133,21 +133,9 @@ bool open_calibration(cv::FileStorage& fs, const std::filesystem::path& path) {
   return fs.open(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
 }
 
-}  // namespace
-
-Result<Camera> load_camera(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    return fail(fmt::format("{}: calibration file not found", file));
-  cv::FileStorage fs;
-  try {
-    // OpenCV throws on a malformed file; turn that into an error value.
-    if (!open_calibration(fs, path))
-      return fail(fmt::format("{}: cannot open as an OpenCV or ROS camera_info calibration file", file));
-  } catch (const cv::Exception& e) {
-    return fail(fmt::format("{}: not a readable OpenCV or ROS camera_info calibration file: {}", file, e.what()));
-  }
+// The camera from an opened file whose top level is a map (load_camera catches what
+// OpenCV throws).
+Result<Camera> read_camera(const cv::FileStorage& fs, const std::string& file) {
   // ROS names its lens model; only the one covtrack computes (OpenCV's k1 k2 p1 p2 k3) is taken.
   if (const cv::FileNode model = fs["distortion_model"]; !model.empty()) {
     const std::string name = model.isString() ? static_cast<std::string>(model) : std::string("?");
@@ -199,9 +187,39 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
   if (!sig->empty()) {
     if (sig->total() < 4)
       return fail(fmt::format("{}: key 'intrinsics_std_deviations' needs fx fy cx cy", file));
-    for (int i = 0; i < 4; ++i) cam.intrinsic_sigmas_px[i] = sig->at<double>(i);
+    // Each becomes a variance of every projected pixel: a NaN or a negative one is a
+    // damaged file, to be named here rather than found as NaN regions.
+    constexpr const char* kNames[4] = {"fx", "fy", "cx", "cy"};
+    for (int i = 0; i < 4; ++i) {
+      const double sigma = sig->at<double>(i);
+      if (!(std::isfinite(sigma) && sigma >= 0))
+        return fail(fmt::format("{}: key 'intrinsics_std_deviations': {} is {}, not a standard deviation (finite, 0 or more)",
+                                file, kNames[i], sigma));
+      cam.intrinsic_sigmas_px[i] = sigma;
+    }
   }
   return cam;
+}
+
+}  // namespace
+
+Result<Camera> load_camera(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    return fail(fmt::format("{}: calibration file not found", file));
+  cv::FileStorage fs;
+  // OpenCV throws on a malformed file, and on a key looked up in a top level that is not
+  // a map of keys (a YAML list, a second document): each becomes an error value.
+  try {
+    if (!open_calibration(fs, path))
+      return fail(fmt::format("{}: cannot open as an OpenCV or ROS camera_info calibration file", file));
+    if (!fs.root().isMap())
+      return fail(fmt::format("{}: not a calibration file: its top level is not a map of keys", file));
+    return read_camera(fs, file);
+  } catch (const cv::Exception& e) {
+    return fail(fmt::format("{}: not a readable OpenCV or ROS camera_info calibration file: {}", file, e.what()));
+  }
 }
 
 Result<void> save_camera(const Camera& camera, const std::filesystem::path& path) {
