@@ -584,6 +584,20 @@ TEST(CameraFile, IntrinsicSigmasMustBeFiniteAndNotNegative) {
   }
 }
 
+// OpenCV allocates a matrix's rows x cols before reading its data: found by fuzz_camera,
+// where "rows:`3" asked for 48 GB.
+TEST(CameraFile, AMatrixSizeBeyondACalibrationsIsAnErrorNotAnAllocation) {
+  for (const std::string rows : {"`3", "3000000", "-3", "0"}) {
+    const auto path = write_temp("covtrack_cam_rows.yml",
+                                 "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n"
+                                 "camera_matrix: !!opencv-matrix\n   rows: " + rows + "\n   cols: 3\n   dt: d\n"
+                                 "   data: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n" + kDist);
+    const auto cam = load_camera(path);
+    ASSERT_FALSE(cam) << rows;
+    EXPECT_NE(cam.error().message.find("camera_matrix': rows and cols"), std::string::npos) << cam.error().message;
+  }
+}
+
 TEST(CameraFile, GarbageIsAnErrorNotACrash) {
   const auto path = write_temp("covtrack_cam_garbage.yml", "%YAML:1.0\n---\n[[[ :: not yaml\n");
   const auto cam = load_camera(path);

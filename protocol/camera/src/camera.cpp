@@ -94,6 +94,17 @@ Result<cv::Mat> read_matrix(const cv::FileStorage& fs, const std::string& file,
     return fail(fmt::format("{}: missing key '{}'", file, key));
   }
   if (node.isMap() && node["dt"].empty()) return read_untagged_matrix(node, file, key);
+  // OpenCV allocates rows x cols before it reads the data: a damaged size must not ask for
+  // gigabytes. A calibration's matrices have at most 18 entries (calibrateCamera's
+  // intrinsics_std_deviations).
+  constexpr long long kMostEntries = 64;
+  if (node.isMap()) {
+    const cv::FileNode rows = node["rows"], cols = node["cols"];
+    if (!rows.isInt() || !cols.isInt() || static_cast<int>(rows) < 1 || static_cast<int>(cols) < 1 ||
+        static_cast<long long>(static_cast<int>(rows)) * static_cast<int>(cols) > kMostEntries)
+      return fail(fmt::format("{}: key '{}': rows and cols must be whole numbers, at least 1, with at most {} "
+                              "entries in all", file, key, kMostEntries));
+  }
   cv::Mat m;
   try {
     node >> m;
