@@ -598,6 +598,24 @@ TEST(CameraFile, AMatrixSizeBeyondACalibrationsIsAnErrorNotAnAllocation) {
   }
 }
 
+// OpenCV 4.6's readers loop forever on a 0xFF byte and recurse once per nesting level
+// (calibration_text.hpp): such text is refused before they see it.
+TEST(CameraFile, TextOpenCVCannotReadSafelyIsRefusedFirst) {
+  const auto byte_ff = write_temp("covtrack_cam_ff.yml", " -\xff\n-\n-");
+  auto cam = load_camera(byte_ff);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find("byte 2 is 0xFF"), std::string::npos) << cam.error().message;
+  const auto deep = write_temp("covtrack_cam_deep.yml", "%YAML:1.0\n---\na: " + std::string(100000, '[') + "\n");
+  cam = load_camera(deep);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find("nested more than 32 deep"), std::string::npos) << cam.error().message;
+  const auto deep_xml = write_temp("covtrack_cam_deep.xml", "<?xml version=\"1.0\"?>\n<opencv_storage>" +
+                                                                 std::string(100000, '<') + "</opencv_storage>\n");
+  cam = load_camera(deep_xml);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find("nested more than 32 deep"), std::string::npos) << cam.error().message;
+}
+
 TEST(CameraFile, GarbageIsAnErrorNotACrash) {
   const auto path = write_temp("covtrack_cam_garbage.yml", "%YAML:1.0\n---\n[[[ :: not yaml\n");
   const auto cam = load_camera(path);

@@ -9,6 +9,8 @@
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
 
+#include "calibration_text.hpp"
+
 #include <string>
 
 namespace covtrack {
@@ -131,17 +133,27 @@ Result<int> read_positive_int(const cv::FileStorage& fs, const std::string& file
   return v;
 }
 
+// The file's text, checked (calibration_text.hpp) before OpenCV reads it from memory.
 // OpenCV's YAML reader wants its "%YAML:1.0" first line, which ROS's camera_info files
 // (camera_calibration_parsers) do not have: such a file is read with the line added.
-bool open_calibration(cv::FileStorage& fs, const std::filesystem::path& path) {
-  const auto ext = path.extension().string();
-  if (ext != ".yaml" && ext != ".yml") return fs.open(path.string(), cv::FileStorage::READ);
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
-  if (!yaml.starts_with("%YAML")) yaml = "%YAML:1.0\n---\n" + yaml;
-  return fs.open(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+Result<void> open_calibration(cv::FileStorage& fs, const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string text(kMostCalibrationBytes + 1, '\0');  // one more: a longer file is refused
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (in.bad()) return fail(fmt::format("{}: cannot read", path.string()));
+  if (auto checked = check_calibration_text(text); !checked)
+    return fail(fmt::format("{}: not a calibration file: {}", path.string(), checked.error().message));
+  int format = cv::FileStorage::FORMAT_AUTO;
+  if (const auto ext = path.extension().string(); ext == ".yaml" || ext == ".yml") {
+    if (!text.starts_with("%YAML")) text = "%YAML:1.0\n---\n" + text;
+    format = cv::FileStorage::FORMAT_YAML;
+  } else if (ext == ".xml") {
+    format = cv::FileStorage::FORMAT_XML;
+  }
+  if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | format))
+    return fail(fmt::format("{}: cannot open as an OpenCV or ROS camera_info calibration file", path.string()));
+  return {};
 }
 
 // The camera from an opened file whose top level is a map (load_camera catches what
@@ -223,8 +235,7 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
   // OpenCV throws on a malformed file, and on a key looked up in a top level that is not
   // a map of keys (a YAML list, a second document): each becomes an error value.
   try {
-    if (!open_calibration(fs, path))
-      return fail(fmt::format("{}: cannot open as an OpenCV or ROS camera_info calibration file", file));
+    if (auto opened = open_calibration(fs, path); !opened) return std::unexpected(opened.error());
     if (!fs.root().isMap())
       return fail(fmt::format("{}: not a calibration file: its top level is not a map of keys", file));
     return read_camera(fs, file);
