@@ -4,12 +4,12 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
-#include <sstream>
 
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
 
 #include "calibration_text.hpp"
+#include "isolated_read.hpp"
 
 #include <string>
 
@@ -133,27 +133,29 @@ Result<int> read_positive_int(const cv::FileStorage& fs, const std::string& file
   return v;
 }
 
-// The file's text, checked (calibration_text.hpp) before OpenCV reads it from memory.
-// OpenCV's YAML reader wants its "%YAML:1.0" first line, which ROS's camera_info files
+// The file's text, checked (calibration_text.hpp), and the format OpenCV is to read it
+// as. OpenCV's YAML reader wants its "%YAML:1.0" first line, which ROS's camera_info files
 // (camera_calibration_parsers) do not have: such a file is read with the line added.
-Result<void> open_calibration(cv::FileStorage& fs, const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string text(kMostCalibrationBytes + 1, '\0');  // one more: a longer file is refused
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
-  if (in.bad()) return fail(fmt::format("{}: cannot read", path.string()));
-  if (auto checked = check_calibration_text(text); !checked)
-    return fail(fmt::format("{}: not a calibration file: {}", path.string(), checked.error().message));
+struct CalibrationText {
+  std::string text;
   int format = cv::FileStorage::FORMAT_AUTO;
+};
+
+Result<CalibrationText> read_calibration_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  CalibrationText c{std::string(kMostCalibrationBytes + 1, '\0')};  // one more: a longer file is refused
+  in.read(c.text.data(), static_cast<std::streamsize>(c.text.size()));
+  c.text.resize(static_cast<std::size_t>(in.gcount()));
+  if (in.bad()) return fail(fmt::format("{}: cannot read", path.string()));
+  if (auto checked = check_calibration_text(c.text); !checked)
+    return fail(fmt::format("{}: not a calibration file: {}", path.string(), checked.error().message));
   if (const auto ext = path.extension().string(); ext == ".yaml" || ext == ".yml") {
-    if (!text.starts_with("%YAML")) text = "%YAML:1.0\n---\n" + text;
-    format = cv::FileStorage::FORMAT_YAML;
+    if (!c.text.starts_with("%YAML")) c.text = "%YAML:1.0\n---\n" + c.text;
+    c.format = cv::FileStorage::FORMAT_YAML;
   } else if (ext == ".xml") {
-    format = cv::FileStorage::FORMAT_XML;
+    c.format = cv::FileStorage::FORMAT_XML;
   }
-  if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | format))
-    return fail(fmt::format("{}: cannot open as an OpenCV or ROS camera_info calibration file", path.string()));
-  return {};
+  return c;
 }
 
 // The camera from an opened file whose top level is a map (load_camera catches what
@@ -224,6 +226,22 @@ Result<Camera> read_camera(const cv::FileStorage& fs, const std::string& file) {
   return cam;
 }
 
+// OpenCV's reading of the text, in the child process of read_isolated. OpenCV throws on
+// malformed text, and on a key looked up in a top level that is not a map of keys (a
+// YAML list, a second document): each becomes an error value.
+Result<Camera> parse_calibration(const CalibrationText& c, const std::string& file) {
+  try {
+    cv::FileStorage fs;
+    if (!fs.open(c.text, cv::FileStorage::READ | cv::FileStorage::MEMORY | c.format))
+      return fail(fmt::format("{}: cannot open as an OpenCV or ROS camera_info calibration file", file));
+    if (!fs.root().isMap())
+      return fail(fmt::format("{}: not a calibration file: its top level is not a map of keys", file));
+    return read_camera(fs, file);
+  } catch (const cv::Exception& e) {
+    return fail(fmt::format("{}: not a readable OpenCV or ROS camera_info calibration file: {}", file, e.what()));
+  }
+}
+
 }  // namespace
 
 Result<Camera> load_camera(const std::filesystem::path& path) {
@@ -231,17 +249,12 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     return fail(fmt::format("{}: calibration file not found", file));
-  cv::FileStorage fs;
-  // OpenCV throws on a malformed file, and on a key looked up in a top level that is not
-  // a map of keys (a YAML list, a second document): each becomes an error value.
-  try {
-    if (auto opened = open_calibration(fs, path); !opened) return std::unexpected(opened.error());
-    if (!fs.root().isMap())
-      return fail(fmt::format("{}: not a calibration file: its top level is not a map of keys", file));
-    return read_camera(fs, file);
-  } catch (const cv::Exception& e) {
-    return fail(fmt::format("{}: not a readable OpenCV or ROS camera_info calibration file: {}", file, e.what()));
-  }
+  const auto text = read_calibration_text(path);
+  if (!text) return std::unexpected(text.error());
+  auto camera = read_isolated([&] { return parse_calibration(*text, file); });
+  if (!camera && !camera.error().message.starts_with(file))
+    return fail(fmt::format("{}: {}", file, camera.error().message));
+  return camera;
 }
 
 Result<void> save_camera(const Camera& camera, const std::filesystem::path& path) {
