@@ -220,9 +220,14 @@ TEST(LenzEndToEnd, EmulatorDaemonClientWithUnplugAndReplug) {
     std::printf(" %.1f%s%s%s", 1e3 * x.delay_s(), in_the_hold(x) ? "h" : "", x.emulator_stalled ? "e" : "",
                 std::isfinite(x.read_s) && x.daemon_stalled ? "d" : "");
   std::printf("\n");
-  // The chain itself (emulator, pseudo-terminal, driver) adds a few milliseconds.
+  // The chain itself (emulator, pseudo-terminal, driver) adds a few milliseconds. A stall
+  // only adds to a delay, and the two streams do not show every stall: a later CI run read
+  // 3 of 6 crossings 92-418 ms late with both streams flowing (a thread of the driver or
+  // of the emulator held up alone), and the others in 1-2 ms. So the chain is judged by
+  // its quicker crossings: a delay of its own would be in every one of them, the lower
+  // quartile included.
   ASSERT_GE(chain_delays.size(), 3u) << "stalls at most crossings: the machine, not the chain, was measured";
-  EXPECT_LT(chain_delays[chain_delays.size() / 2], latency_s / 2);
+  EXPECT_LT(chain_delays[(chain_delays.size() - 1) / 4], latency_s / 2);
   // The crossing that came while the daemon was held up was read late.
   ASSERT_TRUE(held_at_s) << "the locomotive reached no section boundary in 3 s";
   const auto held_crossing = std::find_if(crossings.begin(), crossings.end(), in_the_hold);
