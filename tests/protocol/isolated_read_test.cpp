@@ -20,7 +20,7 @@ TEST(IsolatedRead, TheCameraComesBackWhole) {
   c.fx = 501.5, c.fy = 502.25, c.cx = 319.125, c.cy = 241.0625, c.width_px = 640, c.height_px = 480;
   c.k1 = -0.25, c.k2 = 0.125, c.p1 = 1e-3, c.p2 = -2e-3, c.k3 = 0.0625;
   c.intrinsic_sigmas_px = Eigen::Vector4d(1.5, 1.25, 0.75, 0.5);
-  const auto got = read_isolated([&] { return Result<Camera>(c); });
+  const auto got = read_isolated([&] { return Result<Camera>(c); }, "cam.yml");
   ASSERT_TRUE(got) << got.error().message;
   EXPECT_EQ(got->width_px, 640);
   EXPECT_EQ(got->height_px, 480);
@@ -31,7 +31,7 @@ TEST(IsolatedRead, TheCameraComesBackWhole) {
 }
 
 TEST(IsolatedRead, AnErrorComesBackAsItWas) {
-  const auto got = read_isolated([] { return Result<Camera>(fail("cam.yml: key 'camera_matrix' is missing")); });
+  const auto got = read_isolated([] { return Result<Camera>(fail("cam.yml: key 'camera_matrix' is missing")); }, "cam.yml");
   ASSERT_FALSE(got);
   EXPECT_EQ(got.error().message, "cam.yml: key 'camera_matrix' is missing");
 }
@@ -44,7 +44,7 @@ TEST(IsolatedRead, AReaderThatNeverEndsIsStoppedAtTheLimit) {
         }
         return Result<Camera>(Camera{});
       },
-      300ms);
+      "cam.yml", 300ms);
   ASSERT_FALSE(got);
   EXPECT_NE(got.error().message.find("did not finish within 0.3 s"), std::string::npos) << got.error().message;
   EXPECT_GE(std::chrono::steady_clock::now() - start, 300ms);
@@ -54,7 +54,7 @@ TEST(IsolatedRead, AReaderThatCrashesIsReported) {
   const auto got = read_isolated([] {
     std::raise(SIGSEGV);
     return Result<Camera>(Camera{});
-  });
+  }, "cam.yml");
   ASSERT_FALSE(got);
   EXPECT_NE(got.error().message.find("crashed on it (signal 11)"), std::string::npos) << got.error().message;
 }

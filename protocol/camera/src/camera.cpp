@@ -1,6 +1,7 @@
 #include "covtrack/protocol/camera.hpp"
 #include "covtrack/protocol/camera_opencv.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -143,7 +144,11 @@ struct CalibrationText {
 
 Result<CalibrationText> read_calibration_text(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
-  CalibrationText c{std::string(kMostCalibrationBytes + 1, '\0')};  // one more: a longer file is refused
+  // As much as the file holds, up to one byte more than a calibration may (a longer file
+  // is refused), instead of a zeroed megabyte for a file of a few kilobytes.
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  CalibrationText c{std::string(ec ? kMostCalibrationBytes + 1 : std::min<std::uintmax_t>(size, kMostCalibrationBytes + 1), '\0')};
   in.read(c.text.data(), static_cast<std::streamsize>(c.text.size()));
   c.text.resize(static_cast<std::size_t>(in.gcount()));
   if (in.bad()) return fail(fmt::format("{}: cannot read", path.string()));
@@ -251,10 +256,7 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
     return fail(fmt::format("{}: calibration file not found", file));
   const auto text = read_calibration_text(path);
   if (!text) return std::unexpected(text.error());
-  auto camera = read_isolated([&] { return parse_calibration(*text, file); });
-  if (!camera && !camera.error().message.starts_with(file))
-    return fail(fmt::format("{}: {}", file, camera.error().message));
-  return camera;
+  return read_isolated([&] { return parse_calibration(*text, file); }, file);
 }
 
 Result<void> save_camera(const Camera& camera, const std::filesystem::path& path) {

@@ -63,7 +63,8 @@ Result<Camera> camera_of(const Reply& reply, const std::string& message) {
 
 }  // namespace
 
-Result<Camera> read_isolated(const std::function<Result<Camera>()>& read, std::chrono::milliseconds limit) {
+Result<Camera> read_isolated(const std::function<Result<Camera>()>& read, const std::string& file,
+                             std::chrono::milliseconds limit) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) return read();
   const pid_t child = ::fork();
@@ -103,17 +104,19 @@ Result<Camera> read_isolated(const std::function<Result<Camera>()>& read, std::c
   while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
   }
   if (timed_out)
-    return fail(fmt::format("OpenCV's reader did not finish within {} s and was stopped: the file is damaged "
+    return fail(fmt::format("{}: OpenCV's reader did not finish within {} s and was stopped: the file is damaged "
                             "(OpenCV 4.6 loops forever on some malformed YAML)",
-                            std::chrono::duration<double>(limit).count()));
+                            file, std::chrono::duration<double>(limit).count()));
   Reply reply;
   if (bytes.size() < sizeof reply) {
     if (WIFSIGNALED(status))
-      return fail(fmt::format("OpenCV's reader crashed on it (signal {}): the file is damaged", WTERMSIG(status)));
-    return fail("OpenCV's reader ended without an answer");
+      return fail(fmt::format("{}: OpenCV's reader crashed on it (signal {}): the file is damaged", file,
+                              WTERMSIG(status)));
+    return fail(fmt::format("{}: OpenCV's reader ended without an answer", file));
   }
   std::memcpy(&reply, bytes.data(), sizeof reply);
-  if (!reply.ok && bytes.size() != sizeof reply + reply.message_size) return fail("OpenCV's reader sent a broken answer");
+  if (!reply.ok && bytes.size() != sizeof reply + reply.message_size)
+    return fail(fmt::format("{}: OpenCV's reader sent a broken answer", file));
   return camera_of(reply, bytes.substr(sizeof reply));
 }
 

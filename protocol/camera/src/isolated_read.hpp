@@ -7,6 +7,7 @@
 // a viewer, a Python session) carries on with an error.
 #include <chrono>
 #include <functional>
+#include <string>
 
 #include "covtrack/protocol/camera.hpp"
 
@@ -14,9 +15,10 @@ namespace covtrack {
 
 inline constexpr std::chrono::seconds kCalibrationReadLimit{10};
 
-// `read` run in a forked child, its camera or error sent back. Where no child can be made
-// (no pipe, no fork), `read` runs here.
-Result<Camera> read_isolated(const std::function<Result<Camera>()>& read,
+// `read` run in a forked child, its camera or error sent back as it was; the errors of the
+// child itself (stopped, crashed) name `file`. Where no child can be made (no pipe, no
+// fork), `read` runs here.
+Result<Camera> read_isolated(const std::function<Result<Camera>()>& read, const std::string& file,
                              std::chrono::milliseconds limit = kCalibrationReadLimit);
 
 }  // namespace covtrack
