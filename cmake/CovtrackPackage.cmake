@@ -59,5 +59,5 @@ set(CPACK_DEBIAN_DEV_DESCRIPTION "covtrack SDK: headers, libraries, CMake packag
  Client library (subscriber, transform graph, screen error regions), protocol and LCM log
  libraries; find_package(covtrack) or pkg-config covtrack.")
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
-    "liblcm-dev, libsodium-dev, libeigen3-dev, libfmt-dev, libqhull-dev, libopencv-core-dev")
+    "liblcm-dev, libsodium-dev, libeigen3-dev, libfmt-dev, libqhull-dev, libopencv-core-dev, libyaml-cpp-dev, libtinyxml2-dev")
 include(CPack)

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds the unit tests of the pure parts (protocol and wire decoding, the device
-# decoders, config, layout and scene readers, LCM log reading and replay, the client's
-# sequence tracking) with AddressSanitizer and UndefinedBehaviorSanitizer, and runs them
-# with the fuzz corpora (replayed once). Any sanitizer report fails the test that made it.
+# decoders, the config, layout, scene and camera calibration readers, LCM log reading and
+# replay, the client's sequence tracking) with AddressSanitizer and UndefinedBehaviorSanitizer,
+# and runs them with the fuzz corpora (replayed once). Any sanitizer report fails the test
+# that made it.
 # The renders, the OpenGL, the end-to-end daemon and the client's Monte Carlo tests
 # (graph_test: minutes under the sanitizers) are left to the plain build (tools/test.sh).
 # Usage: tests/sanitized_tests.sh [--build-only] [BUILD_DIR]   (default: build-sanitize)
@@ -13,7 +14,7 @@ if [[ ${1:-} == --build-only ]]; then build_only=true; shift; fi
 build=${1:-build-sanitize}
 tests=(protocol_test channels_test wire_decode_test lcm_datagram_test message_auth_test lenz_decoder_test
        serial6dof_decoder_test hydra_test motion_gate_test vrpn_wire_test config_test vrpn_config_test
-       lcmlog_file_test lcmlog_replay_test scene_test sequence_tracker_test)
+       lcmlog_file_test lcmlog_replay_test scene_test sequence_tracker_test camera_file_test)
 tests/configure_sanitized.sh "$build"
 cmake --build "$build" -j"$(nproc)" --target "${tests[@]}" covtrack_fuzzers
 $build_only && exit 0

@@ -10,6 +10,7 @@ packages=(build-essential cmake pkg-config liblcm-dev liblcm-bin libeigen3-dev
           libgtest-dev libgmock-dev libbenchmark-dev libopencv-core-dev libopencv-imgproc-dev
           libopencv-calib3d-dev libopencv-imgcodecs-dev libopencv-videoio-dev libopencv-highgui-dev
           libapriltag-dev libqhull-dev libserial-dev libusb-1.0-0-dev libhidapi-dev libsodium-dev xvfb xauth
+          libyaml-cpp-dev libtinyxml2-dev  # camera calibration files (YAML, XML)
           xdotool  # the window tests move the mouse and press keys
           iproute2 util-linux python3-dev pybind11-dev python3-numpy python3-pytest
           default-jdk-headless liblcm-java libjchart2d-java

@@ -71,8 +71,8 @@ struct Camera {
 // data} matrices, `distortion_model` plumb_bob or rational_polynomial; the rectification
 // and projection matrices, for stereo, are not used). Errors name the file and the key.
 // A damaged file is an error, never a hang or a crash: the text is checked first (at most
-// 1 MiB, nested at most 32 deep), then OpenCV reads it in a child process (fork), stopped
-// after 10 s, because OpenCV 4.6's reader loops forever on some malformed YAML.
+// 1 MiB, nested at most 32 deep), then read by yaml-cpp or tinyxml2 (not OpenCV, whose
+// reader loops forever on some malformed YAML). A key given twice is an error.
 Result<Camera> load_camera(const std::filesystem::path& file);
 
 // Writes `camera` in OpenCV's layout, which load_camera reads back (the fiducial renderer
