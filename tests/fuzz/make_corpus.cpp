@@ -3,6 +3,7 @@
 // seeds are the shipped files, copied by make_corpus.sh. Run by hand after a format
 // changes: make_corpus OUT_DIR (tests/fuzz/make_corpus.sh does both).
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include <covtrack/device_status_t.hpp>
 
 #include "covtrack/lcmlog/log_writer.hpp"
+#include "covtrack/protocol/camera.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/pose_message.hpp"
 #include "covtrack/vrpn/message_names.hpp"
@@ -268,6 +270,17 @@ void vrpn_seeds() {
   write("vrpn", "client_handshake_ping_report", stream);
 }
 
+// OpenCV's XML, as cv::FileStorage writes it (the YAML seeds are the shipped files).
+void camera_seeds() {
+  Camera camera;
+  camera.width_px = 640, camera.height_px = 480;
+  camera.fx = 552.31, camera.fy = 551.08, camera.cx = 318.74, camera.cy = 243.52;
+  camera.k1 = -0.04127, camera.k2 = 0.1834, camera.p1 = 6.1e-4, camera.p2 = -3.2e-4, camera.k3 = -0.2915;
+  camera.intrinsic_sigmas_px = {1.8, 1.7, 0.9, 1.1};
+  std::filesystem::create_directories(out_dir / "camera");
+  if (!save_camera(camera, out_dir / "camera" / "opencv_640x480.xml")) std::exit(1);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -283,5 +296,6 @@ int main(int argc, char** argv) {
   lcm_log_seeds();
   regions_seeds();
   vrpn_seeds();
+  camera_seeds();
   return 0;
 }

@@ -25,6 +25,7 @@ copy() {  # copy HARNESS FILES...
 copy daemon_config $(ls config/*.toml | grep -v layout)
 copy lenz_layout config/lenz_layout.toml tests/data/lenz_short_layout.toml
 copy scene config/scenes/*.toml
+copy camera config/cameras/*.yml tests/data/ros_camera_info_640x480.yaml
 # The start of a recorded Lenz session: raw device bytes and poses, cut mid-event.
 head -c 4096 tests/data/lenz_session.lcm >"$corpus/lcm_log/seed_lenz_session_start"
 du -sh "$corpus"
