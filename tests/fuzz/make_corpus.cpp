@@ -17,6 +17,7 @@
 #include "covtrack/protocol/camera.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/pose_message.hpp"
+#include "covtrack/scene/transform_table.hpp"
 #include "covtrack/vrpn/message_names.hpp"
 #include "covtrack/vrpn/session.hpp"
 #include "covtrack/vrpn/tracker_report.hpp"
@@ -281,6 +282,15 @@ void camera_seeds() {
   if (!save_camera(camera, out_dir / "camera" / "opencv_640x480.xml")) std::exit(1);
 }
 
+// A scene's bulk edges: a comment, the header, a chain of three rows.
+void transform_table_seeds() {
+  const std::string table = "# a chain from the room to a tool\n" + std::string(scene::kTransformTableHeader) +
+                            "\nroom,rig,0.5,0,2.1,0,-90,15,0.001,0.001,0.002,0.002,0.002,0.004\n"
+                            "rig,arm,0,0.25,0,5,0,0,0.0005,0.0005,0.0005,0.001,0.001,0.001\n"
+                            "arm,tool,0.1,0,0.05,0,45,-30,0,0,0,0,0,0\n";
+  write("transform_table", "chain.csv", Bytes(table.begin(), table.end()));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -297,5 +307,6 @@ int main(int argc, char** argv) {
   regions_seeds();
   vrpn_seeds();
   camera_seeds();
+  transform_table_seeds();
   return 0;
 }
