@@ -216,8 +216,9 @@ TEST(CameraFile, TextOpenCVHungOnIsAnError) {
     const auto cam = load_camera(path);
     ASSERT_FALSE(cam) << name;
     EXPECT_EQ(cam.error().message.rfind(path.string() + ": ", 0), 0u) << cam.error().message;
-    if (std::string(name).find("nesting") != std::string::npos)
+    if (std::string(name).find("nesting") != std::string::npos) {
       EXPECT_NE(cam.error().message.find("nested more than"), std::string::npos) << cam.error().message;
+    }
   }
 }
 
@@ -237,12 +238,12 @@ TEST(CameraFile, AKeyGivenTwiceIsAnError) {
       << cam.error().message;
 }
 
-// What OpenCV itself writes, in YAML and in XML (cv::FileStorage, as its calibration
+// What OpenCV itself writes, in YAML, XML and JSON (cv::FileStorage, as its calibration
 // sample and save_camera do), reads back as the camera written.
-TEST(CameraFile, ReadsWhatOpenCVWritesInYamlAndXml) {
+TEST(CameraFile, ReadsWhatOpenCVWritesInYamlXmlAndJson) {
   auto written = test::example_camera();
   written.intrinsic_sigmas_px = {1.8, 1.7, 0.9, 1.1};
-  for (const char* name : {"covtrack_cam_written.yml", "covtrack_cam_written.xml"}) {
+  for (const char* name : {"covtrack_cam_written.yml", "covtrack_cam_written.xml", "covtrack_cam_written.json"}) {
     const auto path = std::filesystem::temp_directory_path() / name;
     ASSERT_TRUE(save_camera(written, path).has_value()) << name;
     const auto cam = load_camera(path);

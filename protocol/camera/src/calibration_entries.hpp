@@ -1,8 +1,9 @@
 #pragma once
 // A calibration file's top-level entries, in one shape for every syntax covtrack reads:
-// OpenCV's FileStorage YAML and XML, and ROS's camera_info YAML. yaml-cpp and tinyxml2
-// read the text: both report damaged text as an error and bound their recursion, where
-// OpenCV 4.6's own reader loops forever on some damaged YAML (docs/design.md).
+// OpenCV's FileStorage YAML, XML and JSON (which the YAML reader reads), and ROS's
+// camera_info YAML. yaml-cpp and tinyxml2 read the text: both report damaged text as an
+// error and bound their recursion, where OpenCV 4.6's own reader loops forever on some
+// damaged YAML (docs/design.md).
 #include <map>
 #include <optional>
 #include <string>

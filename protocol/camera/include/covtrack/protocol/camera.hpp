@@ -66,8 +66,9 @@ struct Camera {
 // Reads `camera_matrix`, `distortion_coefficients` (4 or 5 values, or none; longer
 // vectors only if the extra terms are zero), `image_width`, `image_height`, and the
 // optional `intrinsics_std_deviations` (fx fy cx cy first, as cv::calibrateCamera orders
-// them). Two layouts: OpenCV's (cv::FileStorage YAML or XML, as its calibration sample
-// writes) and ROS's camera_info YAML (camera_calibration_parsers: untagged {rows, cols,
+// them). Two layouts: OpenCV's (cv::FileStorage YAML, XML or JSON, as its calibration
+// sample writes; XML by the name's .xml or, for a name that is not .yml or .yaml, by a
+// first character '<') and ROS's camera_info YAML (camera_calibration_parsers: untagged {rows, cols,
 // data} matrices, `distortion_model` plumb_bob or rational_polynomial; the rectification
 // and projection matrices, for stereo, are not used). Errors name the file and the key.
 // A damaged file is an error, never a hang or a crash: the text is checked first (at most
