@@ -271,7 +271,8 @@ void vrpn_seeds() {
   write("vrpn", "client_handshake_ping_report", stream);
 }
 
-// OpenCV's XML, as cv::FileStorage writes it (the YAML seeds are the shipped files).
+// OpenCV's XML and JSON, as cv::FileStorage writes them (the YAML seeds are the shipped
+// files).
 void camera_seeds() {
   Camera camera;
   camera.width_px = 640, camera.height_px = 480;
@@ -279,7 +280,8 @@ void camera_seeds() {
   camera.k1 = -0.04127, camera.k2 = 0.1834, camera.p1 = 6.1e-4, camera.p2 = -3.2e-4, camera.k3 = -0.2915;
   camera.intrinsic_sigmas_px = {1.8, 1.7, 0.9, 1.1};
   std::filesystem::create_directories(out_dir / "camera");
-  if (!save_camera(camera, out_dir / "camera" / "opencv_640x480.xml")) std::exit(1);
+  for (const char* name : {"opencv_640x480.xml", "opencv_640x480.json"})
+    if (!save_camera(camera, out_dir / "camera" / name)) std::exit(1);
 }
 
 // A scene's bulk edges: a comment, the header, a chain of three rows.
