@@ -13,8 +13,8 @@
 #include <covtrack/device_claim_t.hpp>
 #include <covtrack/device_status_t.hpp>
 
+#include "client/example_camera.hpp"
 #include "covtrack/lcmlog/log_writer.hpp"
-#include "covtrack/protocol/camera.hpp"
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/pose_message.hpp"
 #include "covtrack/scene/transform_table.hpp"
@@ -274,10 +274,7 @@ void vrpn_seeds() {
 // OpenCV's XML and JSON, as cv::FileStorage writes them (the YAML seeds are the shipped
 // files).
 void camera_seeds() {
-  Camera camera;
-  camera.width_px = 640, camera.height_px = 480;
-  camera.fx = 552.31, camera.fy = 551.08, camera.cx = 318.74, camera.cy = 243.52;
-  camera.k1 = -0.04127, camera.k2 = 0.1834, camera.p1 = 6.1e-4, camera.p2 = -3.2e-4, camera.k3 = -0.2915;
+  Camera camera = test::example_camera();
   camera.intrinsic_sigmas_px = {1.8, 1.7, 0.9, 1.1};
   std::filesystem::create_directories(out_dir / "camera");
   for (const char* name : {"opencv_640x480.xml", "opencv_640x480.json"})

@@ -141,9 +141,9 @@ Result<std::vector<double>> read_matrix(const CalibrationEntries& entries, const
     if (!channels) return fail(fmt::format("{}: key '{}': dt '{}' is not an OpenCV element type", file, key, *value.dt));
     per_element = *channels;
   }
-  // The text is at most 1 MiB, so no data list reaches kLonger entries: a size past it
-  // cannot match, and is not multiplied (where it could overflow).
-  constexpr long long kLonger = 1 << 20;
+  // No data list has as many entries as the text has bytes: a size past that cannot
+  // match, and is not multiplied (where it could overflow).
+  constexpr auto kLonger = static_cast<long long>(kMostCalibrationBytes);
   if (rows >= 0 && cols >= 0 &&
       (rows > kLonger || cols > kLonger || rows * cols * per_element != static_cast<long long>(data.size())))
     return fail(fmt::format("{}: key '{}': {} x {} matrix with {} data entries", file, key, rows, cols, data.size()));
