@@ -59,6 +59,15 @@ double unseen_for_s(const Look& current, Clock::time_point now) {
 }
 
 Clock::duration seconds(double s) { return duration_cast<Clock::duration>(duration<double>(s)); }
+double seconds_of(Clock::time_point t) { return duration<double>(t.time_since_epoch()).count(); }  // as now_s()
+
+// Bytes as read: when the read returned them (what a report in them is timed by, however
+// long the driver then takes to act on it: a crossing must not seem later than it was)
+// and how long they may have waited unread before (unread_for_s).
+struct Read {
+  double at_s = 0;
+  double late_s = 0;
+};
 
 class LenzDriver final : public Driver {
  public:
@@ -130,12 +139,12 @@ class LenzDriver final : public Driver {
         last_rx = now;
         bytes_since_reply += *got;
         sink.raw(ByteDirection::FromDevice, buffer.data(), buffer.size());
-        if (handle_bytes(buffer, read_late_s, sink)) {
+        if (handle_bytes(buffer, Read{seconds_of(now), read_late_s}, sink)) {
           watchdog.valid_frame(now);
           bytes_since_reply = 0;
         }
       }
-      take(feedback_.expire(clock_.now_s()), 0.0, sink);  // drops only: changes nothing
+      take(feedback_.expire(clock_.now_s()), Read{clock_.now_s(), 0.0}, sink);  // drops only: changes nothing
       if (auto sent = ask_held(port, sink); !sent) return sent;
       if (now - last_rx > seconds(config_.link_timeout_s))
         return fail(fmt::format("serial port {}: interface silent for {:.1f} s (no reply to the status request)",
@@ -151,7 +160,11 @@ class LenzDriver final : public Driver {
         if (auto sent = send(port, sink, CommandStationStatusRequest{}); !sent) return sent;
         next_keepalive = now + seconds(config_.keepalive_s);
       }
-      if (now >= next_sample_) publish(sink, reckoner_.estimate(clock_.now_s(), unseen_for_s(current, now)));
+      // Timed now, not at the read: the work above may have been held up, and the port
+      // has gone unseen for that long too.
+      const auto publish_at = clock_.now();
+      if (publish_at >= next_sample_)
+        publish(sink, reckoner_.estimate(seconds_of(publish_at), unseen_for_s(current, publish_at)));
     }
     return {};
   }
@@ -181,10 +194,9 @@ class LenzDriver final : public Driver {
 
   // Acts on what the feedback reports did: re-runs the reckoner on a change, counts
   // changes dropped as noise, and keeps the nibbles to ask for again (sent by ask_held).
-  // `read_late_s`: how long the bytes reported may have waited unread.
-  void take(const FeedbackConfirmation::Outcome& outcome, double read_late_s, SampleSink& sink) {
+  void take(const FeedbackConfirmation::Outcome& outcome, const Read& read, SampleSink& sink) {
     if (outcome.changed)
-      reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_.state()), clock_.now_s(), read_late_s);
+      reckoner_.on_occupancy(section_occupancy(*config_.layout, feedback_.state()), read.at_s, read.late_s);
     for (const auto& line : outcome.dropped) sink.count_error(fmt::format("{}: {}", config_.port, line));
     to_ask_.insert(to_ask_.end(), outcome.ask.begin(), outcome.ask.end());
   }
@@ -196,7 +208,7 @@ class LenzDriver final : public Driver {
   }
 
   // Returns whether a status reply came (the sign of life; see session()).
-  bool handle_bytes(std::span<const std::uint8_t> bytes, double read_late_s, SampleSink& sink) {
+  bool handle_bytes(std::span<const std::uint8_t> bytes, const Read& read, SampleSink& sink) {
     bool status_reply = false;
     const FramingCounters before = decoder_.counters();
     const auto frames = decoder_.push(bytes);
@@ -208,7 +220,7 @@ class LenzDriver final : public Driver {
     for (const auto& frame : frames) {
       std::visit(overloaded{
                      [&](const Feedback& fb) {
-                       take(feedback_.apply(fb, reckoner_, clock_.now_s()), read_late_s, sink);
+                       take(feedback_.apply(fb, reckoner_, read.at_s), read, sink);
                      },
                      [&](const InterfaceNotice& n) {
                        if (n.code != 0x04 && n.code != 0x07) sink.count_error(describe_notice(n.code));
