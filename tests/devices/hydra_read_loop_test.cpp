@@ -2,7 +2,8 @@
 // why not a real one) on simulated time: reports queued while the reader was held up are
 // timed one period apart, a full kernel queue is not published, silence is LOST once and
 // repeats the mode switch, reports that parse keep it alive and reports that do not end
-// the run, an unplugged base leaves both controllers LOST.
+// the run, an unplugged base leaves both controllers LOST, and the reports read before it
+// went, in the middle of a backlog, are published.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -239,3 +240,33 @@ TEST(HydraReadLoop, AnUnpluggedBaseEndsTheRunWithBothControllersLost) {
     EXPECT_EQ(run.sink.poses[k].status, TrackingStatus::Lost) << run.sink.poses[k].sensor;
   EXPECT_FALSE(test::scripted_hid().open()) << "the device is closed when the run ends";
 }
+
+// The base unplugged in the middle of a backlog: the reports read before it went are kept,
+// timed as any backlog, and published; the failure shows at the next read and ends the
+// run with both controllers LOST.
+TEST(HydraReadLoop, ReportsReadBeforeAnUnplugMidBacklogArePublished) {
+  test::ManualClock clock(kStep);
+  RunningHydra run(config(), clock);
+  queue_still_hands(2);  // the session's start (the gate holds the first pose)
+  ASSERT_TRUE(clock.run_for(kStep));
+  ASSERT_EQ(run.poses_of("right", TrackingStatus::Ok).size(), 1u);
+  queue_still_hands(10);
+  test::scripted_hid().unplug_after(6);
+  ASSERT_TRUE(clock.run_for(kStep));
+  const std::int64_t read_us = clock.now_us();
+  ASSERT_TRUE(clock.run_until([&] { return run.returned(); }, 1s));
+  ASSERT_FALSE(run.result());
+  EXPECT_NE(run.result().error().message.find("device disconnected"), std::string::npos)
+      << run.result().error().message;
+  for (const std::string sensor : {"left", "right"}) {
+    const auto ok = run.poses_of(sensor, TrackingStatus::Ok);
+    ASSERT_EQ(ok.size(), 7u) << sensor << ": the six reports read before the unplug are not all published";
+    std::vector<std::int64_t> times, expected;
+    for (std::size_t k = 1; k < ok.size(); ++k) times.push_back(ok[k].measurement_time_us);
+    for (int k = 5; k >= 0; --k) expected.push_back(read_us - k * kPeriodUs);
+    EXPECT_EQ(times, expected) << sensor << ": one period apart, the last at the read";
+    EXPECT_FALSE(run.poses_of(sensor, TrackingStatus::Lost).empty()) << sensor;
+  }
+  EXPECT_EQ(test::scripted_hid().waiting(), 4u) << "the reports queued after the unplug stay unread";
+}
+

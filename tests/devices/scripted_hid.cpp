@@ -11,6 +11,7 @@ void ScriptedHid::reset() {
   std::lock_guard l(m_);
   queue_.clear();
   open_ = unplugged_ = false;
+  reads_until_unplugged_ = -1;
   feature_reports_ = 0;
 }
 
@@ -22,6 +23,11 @@ void ScriptedHid::queue(std::span<const std::uint8_t> report) {
 void ScriptedHid::unplug() {
   std::lock_guard l(m_);
   unplugged_ = true;
+}
+
+void ScriptedHid::unplug_after(int reads) {
+  std::lock_guard l(m_);
+  reads_until_unplugged_ = reads;
 }
 
 std::size_t ScriptedHid::waiting() const {
@@ -55,8 +61,10 @@ void ScriptedHid::close() {
 // waits are on its clock); -1 once unplugged.
 int ScriptedHid::read(std::uint8_t* data, std::size_t length) {
   std::lock_guard l(m_);
+  if (reads_until_unplugged_ == 0) unplugged_ = true;
   if (unplugged_) return -1;
   if (queue_.empty()) return 0;
+  if (reads_until_unplugged_ > 0) --reads_until_unplugged_;
   const std::size_t n = std::min(length, queue_.front().size());
   std::memcpy(data, queue_.front().data(), n);
   queue_.pop_front();

@@ -24,8 +24,13 @@ class ScriptedHid {
   void reset();
   // A report waiting in the kernel's queue; reads take them in order.
   void queue(std::span<const std::uint8_t> report);
-  // Reads fail from now on, as when the device is unplugged.
+  // Reads fail from now on, as when the device is unplugged. (hidapi's hidraw reader
+  // checks the descriptor for a hang-up before it reads, so reports still queued in the
+  // kernel are not read either.)
   void unplug();
+  // The device is unplugged after `reads` more reports have been read: the reader takes
+  // them, then fails, as when the base goes in the middle of a backlog.
+  void unplug_after(int reads);
 
   std::size_t waiting() const;
   int feature_reports() const;  // received (the motion-mode switch)
@@ -41,6 +46,7 @@ class ScriptedHid {
   mutable std::mutex m_;
   std::deque<std::vector<std::uint8_t>> queue_;
   bool open_ = false, unplugged_ = false;
+  int reads_until_unplugged_ = -1;  // -1: no unplug due
   int feature_reports_ = 0;
 };
 
