@@ -269,4 +269,3 @@ TEST(HydraReadLoop, ReportsReadBeforeAnUnplugMidBacklogArePublished) {
   }
   EXPECT_EQ(test::scripted_hid().waiting(), 4u) << "the reports queued after the unplug stay unread";
 }
-

@@ -48,6 +48,9 @@ const std::vector<SpeedStep> kProfile{{0.5, 1.5}, {0.15, 1}, {0, 1}, {0.4, 1.5}}
 // reads it in that step or the next), well within the 50 ms the dead reckoning allows.
 constexpr auto kStep = 5ms;
 
+// The driver's pose period (the Rig's rate_hz: 50).
+constexpr std::int64_t kSamplePeriodUs = 20'000;
+
 // A driver's own clock that can hold the driver up once, between its port's answer and its
 // next look at the clock, as when the process is stopped or preempted as its poll returns:
 // the read saw the port as it was before the hold-up, the clock after it.
@@ -97,9 +100,9 @@ class HoldInsideARead final : public test::CaptureSink {
   void raw(ByteDirection direction, const std::uint8_t* data, std::size_t n) override {
     CaptureSink::raw(direction, data, n);
     const bool feedback = direction == ByteDirection::FromDevice && n > 0 && (data[0] & 0xF0) == 0x40;
-    // The driver publishes at most once a period (Rig: 50 Hz): one is due in this loop
-    // once a period has passed since the last.
-    const bool sample_due = driver_clock_ && driver_clock_->now_us() - last_pose_us_ >= 20'000;
+    // The driver publishes at most once a period: one is due in this loop once a period
+    // has passed since the last.
+    const bool sample_due = driver_clock_ && driver_clock_->now_us() - last_pose_us_ >= kSamplePeriodUs;
     if (hold_ == std::chrono::milliseconds::zero() || !feedback || (when_a_sample_is_due_ && !sample_due)) return;
     driver_clock_->advance(std::exchange(hold_, std::chrono::milliseconds::zero()));
     held_ = true;
@@ -137,7 +140,7 @@ struct Rig {
     config.interface = interface;
     config.baud = interface == Interface::LiUsb ? 57600 : 19200;
     config.layout = options.layout;
-    config.rate_hz = 50;
+    config.rate_hz = 1e6 / kSamplePeriodUs;
     config.keepalive_s = 0.2;
     config.link_timeout_s = 1.0;
     config.no_valid_frames_s = 1.0;
@@ -304,10 +307,10 @@ TEST(LenzDriver, ForgedFeedbackNamingAFarSectionIsAskedAgainAndDropped) {
 // stops while the emulator's runs on.
 constexpr auto kHold = 300ms;
 
-// Runs both clocks until the locomotive is `ahead` (to 5 ms less) before a section boundary
-// at speed (10 cm or more in a hold-up): a hold-up that starts within that has the
-// crossing in it.
-bool run_to_just_before_a_crossing(Rig& rig, std::chrono::milliseconds ahead = 25ms) {
+// Runs both clocks until the locomotive is `lead` (to a step less) before a section
+// boundary at speed (10 cm or more in a hold-up): a hold-up that starts within `lead` has
+// the crossing in it.
+bool run_to_just_before_a_crossing(Rig& rig, std::chrono::milliseconds lead = 25ms) {
   const TrackLayout& layout = rig.emulator->layout();
   const auto s_in = [&](std::chrono::milliseconds ahead) {
     return rig.emulator->true_s_at(rig.clock.now_us() + std::chrono::microseconds(ahead).count());
@@ -315,7 +318,7 @@ bool run_to_just_before_a_crossing(Rig& rig, std::chrono::milliseconds ahead = 2
   const auto crossing_within = [&](std::chrono::milliseconds ahead) {
     return layout.section_at(s_in(ahead)) != layout.section_at(s_in(0ms));
   };
-  while (rig.clock.elapsed_s() < 2 || !crossing_within(ahead) || crossing_within(ahead - kStep) ||
+  while (rig.clock.elapsed_s() < 2 || !crossing_within(lead) || crossing_within(lead - kStep) ||
          layout.wrap(s_in(kHold) - s_in(0ms)) < 0.1) {
     if (rig.clock.elapsed_s() > 20) {
       ADD_FAILURE() << "no crossing at speed in 20 s";
@@ -419,7 +422,9 @@ TEST(LenzDriver, APortUnseenWhileTheDriverWorkedIsAllowedForInThePosesAfter) {
   // the driver's next look, two steps on at once. A terminal hands bytes over a little
   // later in real time, and the look may have come first: then again, a period on.
   for (int period = 0; !rig.sink.held() && period < 3; ++period) {
-    while (rig.own_driver_clock.now_us() - rig.sink.last_pose_us() < 10'000) ASSERT_TRUE(rig.run_both_for(kStep));
+    const std::int64_t two_steps_us = std::chrono::microseconds(2 * kStep).count();
+    while (rig.own_driver_clock.now_us() - rig.sink.last_pose_us() < kSamplePeriodUs - two_steps_us)
+      ASSERT_TRUE(rig.run_both_for(kStep));
     rig.emulator->forge_feedback({90, 0x40});
     ASSERT_TRUE(rig.clock.run_for(2 * kStep));
     rig.own_driver_clock.advance(2 * kStep);
