@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <mutex>
 #include <random>
@@ -30,6 +31,7 @@ std::string url_for(int port) {
 struct StreamLog {
   std::int64_t received = 0, gaps = 0, last_sequence = -1;
   std::int64_t max_interval_us = 0, first_receive_us = 0, last_receive_us = 0;
+  std::int64_t first_measured_us = 0, last_measured_us = 0;  // the reports' own times
   std::map<std::int64_t, pose_cov_t> by_time;  // for pairing with the truth
 };
 
@@ -62,8 +64,9 @@ class Collector {
       s.gaps += m->sequence - s.last_sequence - 1;
     const std::int64_t t = now();
     if (s.last_receive_us) s.max_interval_us = std::max(s.max_interval_us, t - s.last_receive_us);
-    if (!s.first_receive_us) s.first_receive_us = t;
+    if (!s.first_receive_us) s.first_receive_us = t, s.first_measured_us = m->measurement_time_us;
     s.last_receive_us = t;
+    s.last_measured_us = m->measurement_time_us;
     s.last_sequence = m->sequence;
     ++s.received;
     if (keep_samples) s.by_time[m->measurement_time_us] = *m;
@@ -176,7 +179,7 @@ TEST(DaemonEndToEnd, FailingDeviceRestartsWhileTheOtherKeepsPublishing) {
   const std::string url = url_for(7703);
   Collector c(url);
   const std::string config =
-      "[daemon]\nrestart_backoff_initial_s = 0.2\nrestart_backoff_max_s = 0.4\n" +
+      "[daemon]\nrestart_backoff_initial_s = 0.2\nrestart_backoff_max_s = 0.4\nheartbeat_hz = 20\n" +
       sim_device("steady", 1, 200) +
       sim_device("flaky", 1, 200, "inject_failure_every_s = 0.3\n");
   test::DaemonProcess daemon(config, url);
@@ -186,12 +189,27 @@ TEST(DaemonEndToEnd, FailingDeviceRestartsWhileTheOtherKeepsPublishing) {
   const auto restarts = [&]() -> std::int64_t { return c.status.count("flaky") ? c.status["flaky"].restarts : 0; };
   for (int waited = 0; waited < 60 && restarts() < 2; ++waited) c.run_for(0.5);
 
-  const auto& steady = c.poses["covtrack/pose/steady/s0"];
-  // The rate over the span it was received, not a count in a fixed window: a slow
-  // start-up on a loaded machine shortens the window without meaning a stall.
-  const double span_s = (steady.last_receive_us - steady.first_receive_us) * 1e-6;
+  const StreamLog steady = c.poses["covtrack/pose/steady/s0"];  // as it stands now
+  // Every tick of the steady device's schedule over the span of its reports is accounted
+  // for: published, or skipped and counted as a drop where the machine held the daemon
+  // up for more than 10 ticks (sim_driver.cpp). Counted by the reports' own times, not in
+  // a fixed window (a slow start-up shortens it), and with the drops: the received rate
+  // alone reads the machine (a CI run with the instrumented build beside the suite
+  // received 401 reports over 2.28 s at 200 Hz, with no gap and no stall; four busy loops
+  // beside this test gave 321 reports and 51 drops over 1.86 s). The drops are those of
+  // the first heartbeat (20 Hz here) sent after the last of these reports.
+  const auto heard_after = [&](std::int64_t time_us) {
+    return c.status.count("steady") && c.status["steady"].time_us >= time_us;
+  };
+  for (int waited = 0; waited < 40 && !heard_after(steady.last_measured_us); ++waited) c.run_for(0.05);
+  ASSERT_TRUE(heard_after(steady.last_measured_us)) << "no heartbeat of the steady device after its reports";
+  const double span_s = (steady.last_measured_us - steady.first_measured_us) * 1e-6;
+  const std::int64_t drops = c.status["steady"].drops;
+  std::printf("steady: %lld reports received and %lld dropped over %.3f s of their times (%.3f s received)\n",
+              static_cast<long long>(steady.received), static_cast<long long>(drops), span_s,
+              (steady.last_receive_us - steady.first_receive_us) * 1e-6);
   EXPECT_GT(span_s, 1.5);
-  EXPECT_GT(steady.received, 0.95 * 200 * span_s) << "over " << span_s << " s";
+  EXPECT_GT(steady.received + drops, 0.95 * 200 * span_s) << "over " << span_s << " s, " << drops << " dropped";
   EXPECT_EQ(steady.gaps, 0);
   // A stall caused by the flaky device's restarts would last at least its back-off
   // (0.2 s); below that bound lie the scheduling hiccups of a loaded 2-core machine
