@@ -59,7 +59,6 @@ double unseen_for_s(const Look& current, Clock::time_point now) {
 }
 
 Clock::duration seconds(double s) { return duration_cast<Clock::duration>(duration<double>(s)); }
-double seconds_of(Clock::time_point t) { return duration<double>(t.time_since_epoch()).count(); }  // as now_s()
 
 // Bytes as read: when the read returned them (what a report in them is timed by, however
 // long the driver then takes to act on it: a crossing must not seem later than it was)
@@ -139,12 +138,13 @@ class LenzDriver final : public Driver {
         last_rx = now;
         bytes_since_reply += *got;
         sink.raw(ByteDirection::FromDevice, buffer.data(), buffer.size());
-        if (handle_bytes(buffer, Read{seconds_of(now), read_late_s}, sink)) {
+        if (handle_bytes(buffer, Read{Clock::seconds_of(now), read_late_s}, sink)) {
           watchdog.valid_frame(now);
           bytes_since_reply = 0;
         }
       }
-      take(feedback_.expire(clock_.now_s()), Read{clock_.now_s(), 0.0}, sink);  // drops only: changes nothing
+      const double now_s = Clock::seconds_of(now);
+      take(feedback_.expire(now_s), Read{now_s, 0.0}, sink);  // drops only: changes nothing
       if (auto sent = ask_held(port, sink); !sent) return sent;
       if (now - last_rx > seconds(config_.link_timeout_s))
         return fail(fmt::format("serial port {}: interface silent for {:.1f} s (no reply to the status request)",
@@ -164,7 +164,7 @@ class LenzDriver final : public Driver {
       // has gone unseen for that long too.
       const auto publish_at = clock_.now();
       if (publish_at >= next_sample_)
-        publish(sink, reckoner_.estimate(seconds_of(publish_at), unseen_for_s(current, publish_at)));
+        publish(sink, reckoner_.estimate(Clock::seconds_of(publish_at), unseen_for_s(current, publish_at)));
     }
     return {};
   }

@@ -31,7 +31,9 @@ class DriverClock {
   // Waits until `deadline` on this clock; false if stop was requested.
   virtual bool sleep_until(std::stop_token stop, time_point deadline) = 0;
 
-  double now_s() const { return std::chrono::duration<double>(now().time_since_epoch()).count(); }
+  double now_s() const { return seconds_of(now()); }
+  // A time of now() in the seconds of now_s().
+  static double seconds_of(time_point t) { return std::chrono::duration<double>(t.time_since_epoch()).count(); }
 };
 
 // The system's clocks: steady_clock for now(), CLOCK_REALTIME for now_us().
