@@ -143,6 +143,11 @@ const BundleTag* board_tag(const TagBundle& board, int id) {
 }
 
 // The board's tags in one frame posed under `model` (those the pose refuses are left out).
+// Each tag's apparent-scale error is taken as its own, not the frame's (TagPose): the
+// residual model above has no term for the correlation between a tag and the tags that
+// place it, so they place it as if there were none. A board's pose takes its depth from
+// where its tags sit, hardly from their sizes, so a tag's scale error shows in its
+// residual either way, and the fitted scale factor is the per-tag spread the driver needs.
 std::vector<BundleObservation> pose_tags(const Camera& camera, const TagBundle& board, const BoardFrame& frame,
                                          const CornerNoiseModel& model, double ambiguity_chi2) {
   std::vector<BundleObservation> out;
@@ -150,7 +155,9 @@ std::vector<BundleObservation> pose_tags(const Camera& camera, const TagBundle& 
     const BundleTag* tag = board_tag(board, d.detection.id);
     if (!tag) continue;
     auto pose = estimate_tag_pose(camera, d.detection.corners_px, tag->size_m, model.noise(d.inputs), ambiguity_chi2);
-    if (pose) out.push_back({*tag, *pose});
+    if (!pose) continue;
+    pose->apparent_scale_px.setZero();
+    out.push_back({*tag, *pose});
   }
   return out;
 }

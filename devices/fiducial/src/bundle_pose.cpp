@@ -17,11 +17,26 @@ using Vec8 = Eigen::Matrix<double, 8, 1>;
 using Mat8 = Eigen::Matrix<double, 8, 8>;
 
 // One tag's corners as the bundle's fit sees them: where they are on the bundle, where
-// they were measured, and the whitening W (W^T W = Sigma^-1) of their covariance.
+// they were measured, the whitening W_i of the tag's own errors (W_i^T W_i = B_i^-1,
+// B_i = Sigma_i - s_i s_i^T: its corner covariance without the apparent scale s_i, which
+// the frame's tags share) and b_i = W_i s_i.
 struct TagCorners {
   std::array<Vec3, 4> X_bundle;
   Vec8 measured;
   Mat8 whiten;
+  Vec8 apparent_scale;
+};
+
+// Tags fitted together. Their joint corner covariance is Sigma = blockdiag(B_i) + s s^T
+// (s the s_i stacked: bundle_pose.hpp). With W = blockdiag(W_i) and b = W s,
+// Sigma^-1 = W^T (I - b b^T / (1 + b^T b)) W = W^T P^T P W,  P = I - c u u^T,
+// u = b / |b|, c = 1 - 1 / sqrt(1 + b^T b): each tag is whitened on its own and the
+// stacked result corrected along one direction, so a fit costs about what it would with
+// the tags independent.
+struct CornerSet {
+  std::vector<TagCorners> tags;
+  Eigen::VectorXd shared;  // u (zero when no tag has a scale term)
+  double shrink = 0;       // c
 };
 
 struct Fit {
@@ -30,6 +45,22 @@ struct Fit {
   double cost = std::numeric_limits<double>::infinity();  // sum of squared whitened residuals
 };
 
+CornerSet corner_set(std::vector<TagCorners> tags) {
+  CornerSet set{std::move(tags), Eigen::VectorXd(), 0};
+  set.shared.resize(8 * static_cast<Eigen::Index>(set.tags.size()));
+  for (std::size_t i = 0; i < set.tags.size(); ++i)
+    set.shared.segment<8>(8 * static_cast<Eigen::Index>(i)) = set.tags[i].apparent_scale;
+  const double b2 = set.shared.squaredNorm();
+  if (b2 > 0) set.shared /= std::sqrt(b2), set.shrink = 1 - 1 / std::sqrt(1 + b2);
+  return set;
+}
+
+CornerSet subset(const CornerSet& all, const std::vector<std::size_t>& which) {
+  std::vector<TagCorners> tags;
+  for (std::size_t i : which) tags.push_back(all.tags[i]);
+  return corner_set(std::move(tags));
+}
+
 Result<TagCorners> corners_of(const BundleObservation& o) {
   TagCorners t;
   const auto X = tag_corner_points(o.tag.size_m);
@@ -37,60 +68,66 @@ Result<TagCorners> corners_of(const BundleObservation& o) {
     t.X_bundle[k] = o.tag.T_bundle_tag * X[k];
     t.measured(2 * k) = o.pose.corners_px[k].x, t.measured(2 * k + 1) = o.pose.corners_px[k].y;
   }
-  const Eigen::LLT<Mat8> llt(o.pose.corner_covariance);
-  if (llt.info() != Eigen::Success) return fail(fmt::format("tag {}: corner covariance is not positive definite", o.tag.id));
+  const Vec8& s = o.pose.apparent_scale_px;
+  const Eigen::LLT<Mat8> llt(o.pose.corner_covariance - s * s.transpose());
+  if (llt.info() != Eigen::Success)
+    return fail(fmt::format("tag {}: corner covariance is not positive definite beyond its apparent-scale part",
+                            o.tag.id));
   t.whiten = llt.matrixL().solve(Mat8::Identity());
+  t.apparent_scale = t.whiten * s;
   return t;
 }
 
 // Every observation's corners, in the order given.
-Result<std::vector<TagCorners>> corners_of_all(const std::vector<BundleObservation>& observations) {
+Result<CornerSet> corners_of_all(const std::vector<BundleObservation>& observations) {
   std::vector<TagCorners> tags;
   for (const auto& o : observations) {
     auto t = corners_of(o);
     if (!t) return std::unexpected(t.error());
     tags.push_back(*t);
   }
-  return tags;
+  return corner_set(std::move(tags));
 }
 
 // Whitened residuals of the tags' corners at T; false when a corner is behind the camera.
-bool residuals(const Camera& cam, const std::vector<TagCorners>& tags, const Pose& T, Eigen::VectorXd& r) {
-  r.resize(8 * static_cast<Eigen::Index>(tags.size()));
-  for (std::size_t i = 0; i < tags.size(); ++i) {
+bool residuals(const Camera& cam, const CornerSet& set, const Pose& T, Eigen::VectorXd& r) {
+  r.resize(8 * static_cast<Eigen::Index>(set.tags.size()));
+  for (std::size_t i = 0; i < set.tags.size(); ++i) {
     Vec8 d;
     for (int k = 0; k < 4; ++k) {
-      const Vec3 p = T * tags[i].X_bundle[k];
+      const Vec3 p = T * set.tags[i].X_bundle[k];
       if (!(p.z() > 0)) return false;
       const cv::Point2d u = pinhole_pixel(cam, p);
-      d(2 * k) = tags[i].measured(2 * k) - u.x, d(2 * k + 1) = tags[i].measured(2 * k + 1) - u.y;
+      d(2 * k) = set.tags[i].measured(2 * k) - u.x, d(2 * k + 1) = set.tags[i].measured(2 * k + 1) - u.y;
     }
-    r.segment<8>(8 * static_cast<Eigen::Index>(i)) = tags[i].whiten * d;
+    r.segment<8>(8 * static_cast<Eigen::Index>(i)) = set.tags[i].whiten * d;
   }
+  r -= set.shrink * set.shared.dot(r) * set.shared;
   return true;
 }
 
-double cost_at(const Camera& cam, const std::vector<TagCorners>& tags, const Pose& T) {
+double cost_at(const Camera& cam, const CornerSet& set, const Pose& T) {
   Eigen::VectorXd r;
-  return residuals(cam, tags, T, r) ? r.squaredNorm() : std::numeric_limits<double>::infinity();
+  return residuals(cam, set, T, r) ? r.squaredNorm() : std::numeric_limits<double>::infinity();
 }
 
 // J^T Sigma^-1 J at T (the information of the BODY perturbation) and J^T Sigma^-1 r.
-void normal_equations(const Camera& cam, const std::vector<TagCorners>& tags, const Pose& T, Mat6& H, Vec6& g) {
-  H.setZero(), g.setZero();
+void normal_equations(const Camera& cam, const CornerSet& set, const Pose& T, Mat6& H, Vec6& g) {
   Eigen::VectorXd r;
-  residuals(cam, tags, T, r);
-  for (std::size_t i = 0; i < tags.size(); ++i) {
+  residuals(cam, set, T, r);
+  Eigen::Matrix<double, Eigen::Dynamic, 6> Jw(8 * static_cast<Eigen::Index>(set.tags.size()), 6);
+  for (std::size_t i = 0; i < set.tags.size(); ++i) {
     Eigen::Matrix<double, 8, 6> J;
-    for (int k = 0; k < 4; ++k) J.block<2, 6>(2 * k, 0) = point_jacobian(cam, T, tags[i].X_bundle[k]);
-    const Eigen::Matrix<double, 8, 6> Jw = tags[i].whiten * J;
-    H += Jw.transpose() * Jw;
-    g += Jw.transpose() * r.segment<8>(8 * static_cast<Eigen::Index>(i));
+    for (int k = 0; k < 4; ++k) J.block<2, 6>(2 * k, 0) = point_jacobian(cam, T, set.tags[i].X_bundle[k]);
+    Jw.block<8, 6>(8 * static_cast<Eigen::Index>(i), 0) = set.tags[i].whiten * J;
   }
+  Jw -= set.shrink * set.shared * (set.shared.transpose() * Jw);
+  H = Jw.transpose() * Jw;
+  g = Jw.transpose() * r;
 }
 
 // Gauss-Newton from T0, halving a step that does not lower the cost.
-Fit gauss_newton(const Camera& cam, const std::vector<TagCorners>& tags, const Pose& T0) {
+Fit gauss_newton(const Camera& cam, const CornerSet& tags, const Pose& T0) {
   Fit f{T0, Mat6::Zero(), cost_at(cam, tags, T0)};
   if (!std::isfinite(f.cost)) return f;
   Mat6 H;
@@ -137,7 +174,7 @@ BundlePose from_one_tag(const BundleObservation& o) {
 }
 
 // Corner-space chi2 between two poses: how well the data tells them apart.
-double separation_chi2(const Camera& cam, const std::vector<TagCorners>& tags, const Pose& a, const Pose& b) {
+double separation_chi2(const Camera& cam, const CornerSet& tags, const Pose& a, const Pose& b) {
   Eigen::VectorXd ra, rb;
   if (!residuals(cam, tags, a, ra) || !residuals(cam, tags, b, rb)) return std::numeric_limits<double>::infinity();
   return (ra - rb).squaredNorm();  // the measured corners cancel
@@ -168,7 +205,7 @@ TagAgreement agreement_of(const Camera& cam, const BundleObservation& o, const F
 // Gauss-Newton from each start, lowest starting cost first, skipping a start near a
 // minimum already found (0.01: 0.6 degrees or 1 cm, far below a flip and far above the
 // noise); the fits sorted by cost.
-std::vector<Fit> fits_from(const Camera& cam, const std::vector<TagCorners>& tags, const std::vector<Pose>& starts) {
+std::vector<Fit> fits_from(const Camera& cam, const CornerSet& tags, const std::vector<Pose>& starts) {
   std::vector<std::pair<double, Pose>> ordered;
   for (const Pose& T : starts) ordered.emplace_back(cost_at(cam, tags, T), T);
   std::sort(ordered.begin(), ordered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -206,7 +243,7 @@ Result<BundlePose> estimate_bundle_pose(const Camera& cam, const std::vector<Bun
   if (observations.size() == 1) return from_one_tag(observations[0]);
   auto corners = corners_of_all(observations);
   if (!corners) return std::unexpected(corners.error());
-  const std::vector<TagCorners>& tags = *corners;
+  const CornerSet& tags = *corners;
 
   // Starts: both solutions of every tag.
   std::vector<std::size_t> members(observations.size());
@@ -246,10 +283,10 @@ Result<BundlePose> estimate_bundle_pose(const Camera& cam, const std::vector<Bun
   for (;;) {
     agreement.clear(), without.clear();
     for (std::size_t m = 0; m < members.size(); ++m) {
-      std::vector<TagCorners> others;
+      std::vector<std::size_t> others;
       for (std::size_t k = 0; k < members.size(); ++k)
-        if (k != m) others.push_back(tags[members[k]]);
-      without.push_back(gauss_newton(cam, others, fit.T));
+        if (k != m) others.push_back(members[k]);
+      without.push_back(gauss_newton(cam, subset(tags, others), fit.T));
       agreement.push_back(agreement_of(cam, observations[members[m]], without.back(), consistency_chi2));
     }
     const auto worst = static_cast<std::size_t>(
@@ -260,11 +297,9 @@ Result<BundlePose> estimate_bundle_pose(const Camera& cam, const std::vector<Bun
     if (!(agreement[worst].chi2 > consistency_chi2) || !majority_without_it) break;
     left_out.push_back(agreement[worst]);
     members.erase(members.begin() + static_cast<std::ptrdiff_t>(worst));
-    std::vector<TagCorners> kept;
-    for (std::size_t k : members) kept.push_back(tags[k]);
     std::vector<Pose> starts = tag_starts(observations, members);
     starts.push_back(without[worst].T);
-    fit = fits_from(cam, kept, starts).front();
+    fit = fits_from(cam, subset(tags, members), starts).front();
   }
   for (const TagAgreement& a : left_out) why.push_back(fmt::format("left out {}", describe(a, consistency_chi2)));
   out.T_camera_bundle = fit.T;
@@ -299,8 +334,7 @@ Result<BundlePose> refine_bundle_pose(const Camera& cam, const std::vector<Bundl
                                       const Pose& start) {
   auto corners = corners_of_all(observations);
   if (!corners) return std::unexpected(corners.error());
-  const std::vector<TagCorners>& tags = *corners;
-  const Fit fit = gauss_newton(cam, tags, start);
+  const Fit fit = gauss_newton(cam, *corners, start);
   if (!std::isfinite(fit.cost) || !fit.covariance.allFinite()) return fail("no bundle pose near the start fits");
   BundlePose out;
   out.T_camera_bundle = fit.T;

@@ -3,15 +3,17 @@
 // visible corners of its tags, with its covariance, and a check that the tags agree.
 //
 // The corners are those each tag's own pose was fitted to (TagPose::corners_px: corrected,
-// undistorted), each tag with its full 8x8 corner covariance Sigma_i. The systematic terms
-// of Sigma_i (a tag's apparent size, each edge's placement) are shared by the corners of
-// one tag and drawn independently for another tag, so the bundle's corner covariance is
-// block-diagonal, and the bundle pose minimises
-//   sum_i r_i^T Sigma_i^-1 r_i,   r_i = corners_i - project(T_camera_bundle T_bundle_tag_i X_k)
-// by Gauss-Newton on the BODY perturbation, started from the tag pose (either solution of
-// any tag, mapped to the bundle) that fits all corners best. Covariance (J^T Sigma^-1 J)^-1
-// with the stacked Jacobian J. With one tag in view the bundle pose is that tag's pose
-// (its covariance and ambiguity test included), mapped to the bundle frame.
+// undistorted), each tag with its full 8x8 corner covariance Sigma_i. Of its systematic
+// terms, each edge's placement and turn are the tag's own, while its apparent scale comes
+// from the frame's image formation and is one error for all the frame's tags (s_i:
+// TagPose::apparent_scale_px). The bundle's corner covariance is therefore
+//   Sigma = blockdiag(Sigma_i - s_i s_i^T) + s s^T,   s = (s_1, ..., s_n) stacked,
+// and the bundle pose minimises r^T Sigma^-1 r, r the stacked corners_i -
+// project(T_camera_bundle T_bundle_tag_i X_k), by Gauss-Newton on the BODY perturbation,
+// started from the tag pose (either solution of any tag, mapped to the bundle) that fits
+// all corners best. Covariance (J^T Sigma^-1 J)^-1 with the stacked Jacobian J. With one
+// tag in view the bundle pose is that tag's pose (its covariance and ambiguity test
+// included), mapped to the bundle frame.
 //
 // Ambiguity (two tags or more): Gauss-Newton also runs from every other start; a distinct
 // minimum whose corners are within `ambiguity_chi2` of the best one's (under Sigma) is
@@ -19,8 +21,10 @@
 //
 // Agreement (two tags or more): each tag's own pose (the nearer of its two solutions) is
 // compared with where the other tags put it, chi2 = e^T (C_tag + A C_others A^T)^-1 e on
-// 6 degrees of freedom (the two estimates share no corner, so their errors are
-// independent; A maps a bundle perturbation to the tag's frame). Above
+// 6 degrees of freedom (A maps a bundle perturbation to the tag's frame). The two
+// estimates share no corner; the apparent scale they share is left out of the test's
+// covariance, which then holds more than the difference's: a little lenient along the
+// tag's line of sight, never quick to call a consistent tag off. Above
 // `consistency_chi2` the tag disagrees and the bundle is DEGRADED:
 //  - while a strict majority of the tags in view still remains without it, the worst
 //    such tag is left out and the rest refitted (the pose and covariance of the agreeing

@@ -98,6 +98,10 @@ Eigen::Matrix<double, 8, 8> edge_line_modes(const std::array<cv::Point2d, 4>& c)
   return M;
 }
 
+Eigen::Matrix<double, 8, 1> apparent_scale_mode(const std::array<cv::Point2d, 4>& c, const CornerNoise& noise) {
+  return noise.scale_sigma_px * edge_line_modes(c).leftCols<4>().rowwise().sum();
+}
+
 Eigen::Matrix<double, 8, 8> corner_covariance(const std::array<cv::Point2d, 4>& c, const CornerNoise& noise) {
   const Eigen::Matrix<double, 8, 8> M = edge_line_modes(c);
   Eigen::Matrix<double, 8, 8> edges = Eigen::Matrix<double, 8, 8>::Zero();
@@ -205,6 +209,7 @@ Result<TagPose> estimate_tag_pose(const Camera& cam, const std::array<cv::Point2
   out.corner_sigma_px = sigma;
   out.corners_px = {image[0], image[1], image[2], image[3]};
   out.corner_covariance = corner_cov;
+  out.apparent_scale_px = apparent_scale_mode(out.corners_px, noise);
   // A pose's covariance from the corners', through the pinhole at that pose.
   const auto covariance_at = [&](const Pose& T) { return pose_covariance(corner_jacobian(cam, T, size_m), corner_cov); };
   out.covariance = covariance_at(out.best.T_camera_tag);

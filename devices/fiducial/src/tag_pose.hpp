@@ -47,6 +47,10 @@ struct TagPose {
   // stacks these of its tags).
   std::array<cv::Point2d, 4> corners_px{};
   Eigen::Matrix<double, 8, 8> corner_covariance = Eigen::Matrix<double, 8, 8>::Zero();
+  // The corners' move for a one-sigma error of the tag's apparent scale (apparent_scale_mode):
+  // its outer product is the part of corner_covariance that the frame's image formation
+  // gives every tag of the frame alike (a bundle's tags share it: bundle_pose.hpp).
+  Eigen::Matrix<double, 8, 1> apparent_scale_px = Eigen::Matrix<double, 8, 1>::Zero();
 };
 
 // The tag's corners in its own frame, in the detector's order (AprilTag 3's).
@@ -88,6 +92,11 @@ std::array<cv::Point2d, 4> move_edges_in(const std::array<cv::Point2d, 4>& corne
 // other three stay: column e (0-3) when edge e moves out along its normal by 1 px, column
 // 4 + e when it turns, its start 1 px out and its end 1 px in.
 Eigen::Matrix<double, 8, 8> edge_line_modes(const std::array<cv::Point2d, 4>& corners_px);
+
+// How the corners move when all four edges move out by noise.scale_sigma_px: the scale
+// term of corner_covariance is this vector's outer product.
+Eigen::Matrix<double, 8, 1> apparent_scale_mode(const std::array<cv::Point2d, 4>& corners_px,
+                                                const CornerNoise& noise);
 
 // The full corner covariance of `noise` for a quad with these (corrected) corners.
 Eigen::Matrix<double, 8, 8> corner_covariance(const std::array<cv::Point2d, 4>& corners_px,
