@@ -24,7 +24,7 @@ struct TagCorners {
   std::array<Vec3, 4> X_bundle;
   Vec8 measured;
   Mat8 whiten;
-  Vec8 apparent_scale;
+  Vec8 whitened_scale;
 };
 
 // Tags fitted together. Their joint corner covariance is Sigma = blockdiag(B_i) + s s^T
@@ -49,7 +49,7 @@ CornerSet corner_set(std::vector<TagCorners> tags) {
   CornerSet set{std::move(tags), Eigen::VectorXd(), 0};
   set.shared.resize(8 * static_cast<Eigen::Index>(set.tags.size()));
   for (std::size_t i = 0; i < set.tags.size(); ++i)
-    set.shared.segment<8>(8 * static_cast<Eigen::Index>(i)) = set.tags[i].apparent_scale;
+    set.shared.segment<8>(8 * static_cast<Eigen::Index>(i)) = set.tags[i].whitened_scale;
   const double b2 = set.shared.squaredNorm();
   if (b2 > 0) set.shared /= std::sqrt(b2), set.shrink = 1 - 1 / std::sqrt(1 + b2);
   return set;
@@ -74,7 +74,7 @@ Result<TagCorners> corners_of(const BundleObservation& o) {
     return fail(fmt::format("tag {}: corner covariance is not positive definite beyond its apparent-scale part",
                             o.tag.id));
   t.whiten = llt.matrixL().solve(Mat8::Identity());
-  t.apparent_scale = t.whiten * s;
+  t.whitened_scale = t.whiten * s;
   return t;
 }
 
