@@ -153,9 +153,7 @@ class Renderer {
       auto b = estimate_bundle_pose(camera_, out.seen);  // the driver's default limits
       EXPECT_TRUE(b.has_value()) << b.error().message;
       if (b) out.bundle = *b;
-      std::vector<BundleObservation> own_scales = out.seen;
-      for (BundleObservation& o : own_scales) o.pose.apparent_scale_px.setZero();
-      if (auto own = estimate_bundle_pose(camera_, own_scales)) out.bundle_own_scales = *own;
+      if (auto own = estimate_bundle_pose(camera_, with_own_scales(out.seen))) out.bundle_own_scales = *own;
     }
     return out;
   }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <utility>
 
 #include <Eigen/Cholesky>
 #include <fmt/format.h>
@@ -155,11 +156,9 @@ std::vector<BundleObservation> pose_tags(const Camera& camera, const TagBundle& 
     const BundleTag* tag = board_tag(board, d.detection.id);
     if (!tag) continue;
     auto pose = estimate_tag_pose(camera, d.detection.corners_px, tag->size_m, model.noise(d.inputs), ambiguity_chi2);
-    if (!pose) continue;
-    pose->apparent_scale_px.setZero();
-    out.push_back({*tag, *pose});
+    if (pose) out.push_back({*tag, *pose});
   }
-  return out;
+  return with_own_scales(std::move(out));
 }
 
 // Every tag view of `frames` with two or more other board tags, predicted from them.

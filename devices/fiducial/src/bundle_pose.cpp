@@ -344,4 +344,9 @@ Result<BundlePose> refine_bundle_pose(const Camera& cam, const std::vector<Bundl
   return out;
 }
 
+std::vector<BundleObservation> with_own_scales(std::vector<BundleObservation> observations) {
+  for (BundleObservation& o : observations) o.pose.apparent_scale_px.setZero();
+  return observations;
+}
+
 }  // namespace covtrack::fiducial

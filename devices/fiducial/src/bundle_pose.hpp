@@ -95,4 +95,9 @@ Result<BundlePose> estimate_bundle_pose(const Camera& camera, const std::vector<
 Result<BundlePose> refine_bundle_pose(const Camera& camera, const std::vector<BundleObservation>& observations,
                                       const Pose& start);
 
+// The observations with each tag's apparent-scale error taken as its own, not the frame's
+// (TagPose::apparent_scale_px cleared): the bundle's corner covariance is then
+// block-diagonal. For a fit whose model has no correlation between tags (board_calibration).
+std::vector<BundleObservation> with_own_scales(std::vector<BundleObservation> observations);
+
 }  // namespace covtrack::fiducial
