@@ -7,7 +7,10 @@
 # Every part runs even when an earlier one failed; the exit code says whether all passed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# mark PHASE: how long the run has taken so far, so a slow CI run shows where its time went.
+mark() { echo "test.sh: $1 after ${SECONDS} s"; }
 tools/setup.sh build
+mark "set-up and build"
 failed=()
 # The instrumented tree builds while the plain suite runs, in the idle scheduling class:
 # the suite spends much of its time waiting on daemons, namespaces and timers, and an
@@ -17,12 +20,16 @@ mkdir -p build-sanitize
 chrt --idle 0 tests/sanitized_tests.sh --build-only build-sanitize >build-sanitize/build.log 2>&1 &
 sanitized_build=$!
 ctest --test-dir build --output-on-failure -j"$(nproc)" || failed+=(tests)
+mark "tests"
 if ! wait "$sanitized_build"; then
   tail -n 40 build-sanitize/build.log
   failed+=(sanitized-build)
 fi
+mark "instrumented build"
 tests/sanitized_tests.sh build-sanitize || failed+=(sanitized-tests)
+mark "sanitized tests"
 tests/fuzz/run_fuzzers.sh --build build-sanitize --seconds 15 || failed+=(fuzzers)
+mark "fuzzers"
 if ((${#failed[@]})); then
   echo "test.sh: FAILED: ${failed[*]}" >&2
   exit 1
