@@ -11,6 +11,7 @@
 //    condition and within chi-square(6)'s 99% bounds pooled.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -212,9 +213,15 @@ double bias_from_truth(const Camera& cam, const TagBundle& b, const RenderedBoar
   return num / den;
 }
 
+// Tags by their edge length: under 60 px, 60-90 px, over 90 px.
+constexpr std::array<const char*, 3> kSizeBands{"under 60 px", "60-90 px", "over 90 px"};
+int size_band(double edge_length_px) { return edge_length_px < 60 ? 0 : edge_length_px < 90 ? 1 : 2; }
+
 struct SingleTagNees {
   double mean = 0, above_99 = 0;
   int count = 0;
+  std::array<double, 3> band_sum{};  // NEES summed by size band (kSizeBands)
+  std::array<int, 3> band_count{};
 };
 
 // Single tags of the other polarity (tagStandard41h12: light square on a dark ring), drawn
@@ -235,12 +242,14 @@ SingleTagNees held_out_nees(const Camera& cam, TagDetector& detector, const Imag
     const double noise = estimate_image_noise(image);
     for (const Detection& d : detector.detect(image)) {
       if (d.id != id) continue;
-      auto pose = estimate_tag_pose(cam, d.corners_px, size,
-                                    model.noise(measure_corner_inputs(image, d, detector.family(), noise)));
+      const CornerInputs inputs = measure_corner_inputs(image, d, detector.family(), noise);
+      auto pose = estimate_tag_pose(cam, d.corners_px, size, model.noise(inputs));
       if (!pose || pose->ambiguous) continue;
       const Vec6 e = boxminus(truth, pose->best.T_camera_tag);
       const double nees = e.dot(pose->covariance.ldlt().solve(e));
       sum += nees, above += nees > 16.812, ++out.count;
+      const auto band = static_cast<std::size_t>(size_band(inputs.edge_length_px));
+      out.band_sum[band] += nees, ++out.band_count[band];
     }
   }
   out.mean = sum / out.count, out.above_99 = static_cast<double>(above) / out.count;
@@ -270,6 +279,8 @@ TEST(BoardCalibration, FitsARenderedCameraAsItsTruthShowsAndHoldsOnOtherFrames) 
   double fitted_bias[2] = {0, 0};
   double pooled_sum = 0;
   int pooled_count = 0;
+  std::array<double, 3> band_sum{};
+  std::array<int, 3> band_count{};
   for (int g = 0; g < 2; ++g) {
     const double gamma = g == 0 ? 1.0 : 2.2;
     const RenderedBoard set =
@@ -307,6 +318,7 @@ TEST(BoardCalibration, FitsARenderedCameraAsItsTruthShowsAndHoldsOnOtherFrames) 
       // 150 tags each: with 60, one seed's tail swung from 5% to 8% with the same model.
       EXPECT_LE(with_fit.above_99, detector == board_detector.get() ? 0.07 : 0.12);
       pooled_sum += with_fit.mean * with_fit.count, pooled_count += with_fit.count;
+      for (std::size_t b = 0; b < 3; ++b) band_sum[b] += with_fit.band_sum[b], band_count[b] += with_fit.band_count[b];
     }
   }
   // Pooled over both cameras, families: chi-square(6)'s 99% bounds for the mean of this many.
@@ -315,6 +327,15 @@ TEST(BoardCalibration, FitsARenderedCameraAsItsTruthShowsAndHoldsOnOtherFrames) 
               6 - half_width, 6 + half_width);
   EXPECT_GT(pooled, 6 - half_width);
   EXPECT_LT(pooled, 6 + half_width);
+  // By the tags' size, pooled the same way: a board of one tag size calibrates the sizes
+  // it shows, and each band stays within 2x (devices/fiducial/README.md, "Limits").
+  for (std::size_t b = 0; b < 3; ++b) {
+    const double mean = band_sum[b] / band_count[b];
+    std::printf("held out, edges %s: NEES %.2f over %d tags\n", kSizeBands[b], mean, band_count[b]);
+    EXPECT_GE(band_count[b], 40);
+    EXPECT_GT(mean, 3);
+    EXPECT_LT(mean, 12);
+  }
   // The tone curve's bias is what the fit tracks: 0.36-0.45 px per px of blur at gamma 2.2.
   EXPECT_LT(fitted_bias[1], fitted_bias[0] - 0.2);
 }
