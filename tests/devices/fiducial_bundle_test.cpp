@@ -219,8 +219,8 @@ TEST(FiducialBundle, CovarianceIsExactForCornersDrawnFromTheModel) {
   noise.sigma_px = 0.08, noise.scale_sigma_px = 0.1, noise.edge_sigma_px = 0.04, noise.tilt_sigma_px = 0.03;
   std::mt19937_64 rng(5);
   std::normal_distribution<double> gauss;
-  double sum = 0;
-  int n = 0, disagree = 0, tags = 0;
+  double sum = 0, agreement_sum = 0;
+  int n = 0, disagree = 0, tags = 0, agreements = 0;
   for (int draw = 0; draw < 1000; ++draw) {
     const auto layout = draw % 2 ? tent(**family) : board(**family);
     const Pose T_camera_bundle = random_bundle_pose(rng);
@@ -244,6 +244,7 @@ TEST(FiducialBundle, CovarianceIsExactForCornersDrawnFromTheModel) {
     ASSERT_TRUE(b.has_value()) << b.error().message;
     sum += nees(T_camera_bundle, b->T_camera_bundle, b->covariance), ++n;
     disagree += b->disagree, tags += static_cast<int>(seen.size());
+    for (const TagAgreement& a : b->agreement) agreement_sum += a.chi2, ++agreements;
   }
   const auto [lo, hi] = mean_bounds(n);
   std::printf("corners drawn from the model: bundle NEES %.3f over %d draws (99%% bounds [%.3f, %.3f]); %d of %d "
@@ -253,6 +254,14 @@ TEST(FiducialBundle, CovarianceIsExactForCornersDrawnFromTheModel) {
   EXPECT_GT(sum / n, lo);
   EXPECT_LT(sum / n, hi);
   EXPECT_LE(disagree, 3 * tags / 1000 + 3) << "about 1 in 1000 tags should disagree";
+  // Each tag against the others: chi-square(6) when the test's covariance is the
+  // difference's. A frame's tags share the scale error and the others' poses, so their
+  // values are not independent: bounds for the number of frames, not of tags.
+  const auto [agreement_lo, agreement_hi] = mean_bounds(n);
+  std::printf("tag against the others: mean chi2 %.3f over %d tags (bounds [%.3f, %.3f])\n",
+              agreement_sum / agreements, agreements, agreement_lo, agreement_hi);
+  EXPECT_GT(agreement_sum / agreements, agreement_lo);
+  EXPECT_LT(agreement_sum / agreements, agreement_hi);
 }
 
 TEST(FiducialBundle, NeesOfTheBundlePoseOnHeldOutRenders) {
