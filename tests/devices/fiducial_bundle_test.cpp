@@ -209,7 +209,8 @@ struct ErrorPair {
 // Catches a wrong Jacobian, a wrong adjoint, or a joint covariance unlike the one the
 // corners are drawn from (each tag's own errors per tag, the apparent scale once per frame;
 // drawn once per tag, they read 9.2). A fit that drops the shared scale still passes (6.04):
-// SharingTheFramesApparentScaleMakesItMorePrecise catches that.
+// SharingTheFramesApparentScaleMakesItMorePrecise catches that. Also catches an agreement
+// test whose covariance is off (the others' covariance taken 0.7x reads 6.44).
 TEST(FiducialBundle, CovarianceIsExactForCornersDrawnFromTheModel) {
   constexpr double kChi2_6_999 = 22.458;
   const Camera cam = test::camera(800, 600, 58);
