@@ -7,11 +7,13 @@
 // resolution, family and lens: a third rasteriser (random points per pixel, with a fill
 // factor), an 800x600 camera and a 1920x1080 one whose distortion the driver knows only
 // approximately, four other families. Checked: every
-// condition (family x resolution x distance band) within 2x (mean NEES in [3, 12]), the
-// pooled NEES (see the bound below), and that the shipped defaults are this calibration.
+// condition (family x resolution x distance band) within 2x (mean NEES in [3, 12]), so is
+// every band of edge length with 10 views or more, the pooled NEES (see the bound below),
+// and that the shipped defaults are this calibration.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -103,6 +105,13 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
   // Validate on the held-out runs.
   const auto validation = validation_set();
   std::map<std::string, std::pair<double, int>> by_condition, by_band;
+  // By the view's mean edge length: under 60 px, 60-90, 90-150, 150 and over.
+  struct SizeBand {
+    const char* name;
+    double sum = 0;
+    int draws = 0, views = 0;
+  };
+  std::array<SizeBand, 4> by_size{{{"under 60 px"}, {"60-90 px"}, {"90-150 px"}, {"150 px and over"}}};
   double pooled_sum = 0;
   int pooled_n = 0;
   std::vector<std::vector<ViewDraw>> validation_draws;
@@ -116,6 +125,13 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
     auto& band = by_band[r.condition.substr(r.condition.rfind(' ', r.condition.size() - 3) + 1)];
     band.first += mean * n, band.second += n;
     pooled_sum += mean * n, pooled_n += n;
+    double edge = 0;
+    int seen = 0;
+    for (const ViewDraw& d : validation_draws[i])
+      if (d.detection) edge += d.inputs.edge_length_px, ++seen;
+    edge /= std::max(seen, 1);
+    SizeBand& size = by_size[edge < 60 ? 0 : edge < 90 ? 1 : edge < 150 ? 2 : 3];
+    size.sum += mean * n, size.draws += n, ++size.views;
   }
   std::printf("%-34s %6s %4s\n", "condition", "NEES", "n");
   for (const auto& [condition, sum_n] : by_condition) {
@@ -137,6 +153,15 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
   std::printf("distance bands: 0.5-1 m NEES %.2f, 1-1.5 m NEES %.2f\n", near_band, far_band);
   EXPECT_LT(std::max(near_band, far_band), 1.2 * std::min(near_band, far_band))
       << "the near and far bands' NEES differ by more than 1.2x";
+  // Within 2x as the conditions are, where a band has enough views to say (few views are of
+  // tags under 60 px: devices/fiducial/README.md, "Limits").
+  for (const SizeBand& b : by_size) {
+    std::printf("edges %s: NEES %.2f over %d draws of %d views\n", b.name, b.draws ? b.sum / b.draws : 0.0,
+                b.draws, b.views);
+    if (b.views < 10) continue;
+    EXPECT_LE(b.sum / b.draws, 12.0) << "edges " << b.name << ": over 2x over-confident";
+    EXPECT_GE(b.sum / b.draws, 3.0) << "edges " << b.name << ": over 2x under-confident";
+  }
   const double pooled = pooled_sum / pooled_n;
   const double half_width = 2.576 * std::sqrt(12.0 / pooled_n);
   std::printf("pooled mean NEES %.3f over %d draws; chi2(6) 99%% bounds for independent draws [%.3f, %.3f]\n",
