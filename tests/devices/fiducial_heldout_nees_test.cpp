@@ -129,7 +129,8 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
     int seen = 0;
     for (const ViewDraw& d : validation_draws[i])
       if (d.detection) edge += d.inputs.edge_length_px, ++seen;
-    edge /= std::max(seen, 1);
+    if (seen == 0) continue;  // no size to file it under (and no pose to judge)
+    edge /= seen;
     SizeBand& size = by_size[edge < 60 ? 0 : edge < 90 ? 1 : edge < 150 ? 2 : 3];
     size.sum += mean * n, size.draws += n, ++size.views;
   }
