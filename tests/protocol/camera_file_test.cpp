@@ -71,6 +71,18 @@ TEST(CameraFile, MissingImageSizeAndUnsupportedDistortion) {
   EXPECT_NE(cam.error().message.find("distortion_coefficients"), std::string::npos);
 }
 
+// A coefficient no lens has: the fuzzer's k3 = -3e301 made the intrinsic covariance infinite.
+TEST(CameraFile, AnAbsurdDistortionCoefficientIsNamed) {
+  const auto path = write_temp("covtrack_cam_absurd_k3.yml",
+                               std::string("%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n") + kMatrix +
+                                   "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n"
+                                   "   dt: d\n   data: [ 0.1, -0.2, 0., 0., -2.915e301 ]\n");
+  const auto cam = load_camera(path);
+  ASSERT_FALSE(cam);
+  EXPECT_NE(cam.error().message.find("coefficient 4 is -2.915e+301, beyond any lens"), std::string::npos)
+      << cam.error().message;
+}
+
 TEST(CameraFile, AnImpossibleImageSizeIsAnErrorNotAnAllocation) {
   const auto path = write_temp("covtrack_cam_huge.yml", std::string("%YAML:1.0\n---\nimage_width: 2000000000\n"
                                                                     "image_height: 480\n") + kMatrix + kDist);

@@ -232,9 +232,18 @@ Result<Camera> load_camera(const std::filesystem::path& path) {
   if (n > 0 && n < 4)  // none (ROS writes an empty list for an undistorted camera), or k1 k2 p1 p2 [k3 ...]
     return fail(fmt::format("{}: key 'distortion_coefficients' needs 4 or 5 values, has {}",
                             file, n));
-  for (int i = 0; i < n; ++i)
+  // No lens has a coefficient near this bound (they are of order 1, a fisheye's in the
+  // tens); beyond it, the projection's derivatives overflow to infinity (a fuzzed file
+  // with k3 = -3e301 gave an infinite intrinsic covariance).
+  constexpr double kMaxCoefficient = 1e6;
+  for (int i = 0; i < n; ++i) {
     if (!std::isfinite((*dist)[i]))
       return fail(fmt::format("{}: key 'distortion_coefficients': coefficient {} is not finite", file, i));
+    if (std::abs((*dist)[i]) > kMaxCoefficient)
+      return fail(fmt::format("{}: key 'distortion_coefficients': coefficient {} is {}, beyond any lens (at most {:g} "
+                              "either way)",
+                              file, i, (*dist)[i], kMaxCoefficient));
+  }
   for (int i = 5; i < n; ++i)
     if ((*dist)[i] != 0)
       return fail(fmt::format(
