@@ -102,6 +102,15 @@ void BM_RegionsAlone(benchmark::State& state) {
     }
 }
 
+std::string object_name(std::size_t i) { return "object" + std::to_string(i); }
+
+// The frame's first n objects into `graph` (a graph holds a mutex: filled, not returned),
+// each a static edge from the camera, as a scene file makes them.
+void add_objects(TransformGraph& graph, const test::BenchFrame& f, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i)
+    (void)graph.add_static_edge("camera", object_name(i), f.poses[i].T, f.poses[i].covariance);
+}
+
 // The step between the two: each object's pose queried from a graph (by keys, as ArView
 // does) and its regions computed into its own output. What it adds to the regions alone is
 // the queries' cost, their memory traffic included (regions into per-object outputs
@@ -110,12 +119,9 @@ void BM_QueriesAndRegions(benchmark::State& state) {
   const test::BenchFrame& f = ar_frame();
   const auto n = static_cast<std::size_t>(state.range(0));
   TransformGraph graph;
+  add_objects(graph, f, n);
   std::vector<TransformGraph::FrameKey> keys;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::string name = "object" + std::to_string(i);
-    (void)graph.add_static_edge("camera", name, f.poses[i].T, f.poses[i].covariance);
-    keys.push_back(*graph.key(name));
-  }
+  for (std::size_t i = 0; i < n; ++i) keys.push_back(*graph.key(object_name(i)));
   const TransformGraph::FrameKey camera = *graph.key("camera");
   std::vector<ObjectRegions> regions(n);
   for (auto _ : state)
@@ -128,13 +134,12 @@ void BM_QueriesAndRegions(benchmark::State& state) {
 
 void BM_ArView(benchmark::State& state) {
   const test::BenchFrame& f = ar_frame();
+  const auto n = static_cast<std::size_t>(state.range(0));
   TransformGraph graph;
+  add_objects(graph, f, n);
   std::vector<ArObject> objects;
-  for (int i = 0; i < state.range(0); ++i) {
-    const std::string name = "object" + std::to_string(i);
-    (void)graph.add_static_edge("camera", name, f.poses[i].T, f.poses[i].covariance);
-    objects.push_back({name, name, f.vertices[i], {20, 60}, 1, {false, false, true}});
-  }
+  for (std::size_t i = 0; i < n; ++i)
+    objects.push_back({object_name(i), object_name(i), f.vertices[i], {20, 60}, 1, {false, false, true}});
   ArViewOptions options;
   options.labels.screen = kScreen;
   auto view = ArView::create(f.camera, "camera", std::move(objects), std::move(options));

@@ -247,10 +247,10 @@ TEST(LenzEndToEnd, EmulatorDaemonClientWithUnplugAndReplug) {
     if (it != truth.begin() && s.time_us - std::prev(it)->first < it->first - s.time_us) --it;
     const double dt = std::abs(static_cast<double>(it->first - s.time_us)) * 1e-6;
     if (dt > 0.05) continue;
-    const double since_read_s = static_cast<double>(s.time_us) * 1e-6 - held_crossing->read_s;
-    const bool right_after_hold = since_read_s >= 0 && since_read_s < 0.1;
+    const double t_s = static_cast<double>(s.time_us) * 1e-6;
+    const bool right_after_hold = t_s >= held_crossing->read_s && t_s < held_crossing->read_s + 0.1;
     after_hold_published += right_after_hold;
-    if (test::rests_on_a_late_command_station(crossings, static_cast<double>(s.time_us) * 1e-6, latency_s)) {
+    if (test::rests_on_a_late_command_station(crossings, t_s, latency_s)) {
       ++not_judged;
       continue;
     }
