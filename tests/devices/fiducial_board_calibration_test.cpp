@@ -328,14 +328,15 @@ TEST(BoardCalibration, FitsARenderedCameraAsItsTruthShowsAndHoldsOnOtherFrames) 
   EXPECT_GT(pooled, 6 - half_width);
   EXPECT_LT(pooled, 6 + half_width);
   // By the tags' size, pooled the same way: a board of one tag size calibrates the sizes
-  // it shows, and each band stays within 2x (devices/fiducial/README.md, "Per-camera
-  // calibration": under 60 px it is the weakest).
+  // it shows. Each band within 1.25x: small tags read 7.60 (1.27x) before the phase-locked
+  // edges' terms (corner_noise.hpp), from the few of them with an edge along the pixel grid
+  // (devices/fiducial/README.md, "Per-camera calibration").
   for (std::size_t b = 0; b < 3; ++b) {
     const double mean = band_sum[b] / band_count[b];
     std::printf("held out, edges %s: NEES %.2f over %d tags\n", kSizeBands[b], mean, band_count[b]);
     EXPECT_GE(band_count[b], 40);
-    EXPECT_GT(mean, 3);
-    EXPECT_LT(mean, 12);
+    EXPECT_GT(mean, 6 / 1.25) << "edges " << kSizeBands[b];
+    EXPECT_LT(mean, 6 * 1.25) << "edges " << kSizeBands[b];
   }
   // The tone curve's bias is what the fit tracks: 0.36-0.45 px per px of blur at gamma 2.2.
   EXPECT_LT(fitted_bias[1], fitted_bias[0] - 0.2);

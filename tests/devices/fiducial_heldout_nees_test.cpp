@@ -9,7 +9,8 @@
 // approximately, four other families. Checked: every
 // condition (family x resolution x distance band) within 2x (mean NEES in [3, 12]), so is
 // every band of edge length with 10 views or more, the pooled NEES (see the bound below),
-// and that the shipped defaults are this calibration.
+// and that the shipped defaults are this calibration. The phase-locked edges' terms are
+// fitted and judged on sets of their own (the second test).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -184,4 +185,57 @@ TEST(FiducialHeldOutNees, CovarianceHoldsOnImagesMadeDifferently) {
               posed_views, clustered_se, 6 - 2.576 * clustered_se, 6 + 2.576 * clustered_se);
   EXPECT_LE(std::abs(pooled - 6), 2.576 * clustered_se)
       << "the pooled NEES is off 6 by more than the views' own spread allows";
+}
+
+// Edges along a pixel row or column (phase-locked: corner_noise.hpp) are rare in a random
+// set, so their terms are fitted on views made to have them, and judged on views made
+// differently (rasteriser, resolution, family, seed; edges up to twice as far off the
+// grid). Without the terms these views read a NEES of about 4x.
+TEST(FiducialHeldOutNees, PhaseLockedEdgesAreCoveredOnViewsMadeDifferently) {
+  const auto draw_all = [](const std::vector<TagRun>& runs, std::uint64_t seed) {
+    std::vector<std::vector<ViewDraw>> draws;
+    for (std::size_t i = 0; i < runs.size(); ++i) draws.push_back(draws_of(runs[i], seed + i));
+    return draws;
+  };
+  const auto calibration = test::locked_edge_calibration_set();
+  CornerNoiseModel model;
+  fit_locked_edges(model, draw_all(calibration, 7000));
+  std::printf("locked edges calibrated: %s\n", describe(model).c_str());
+  const CornerNoiseModel shipped;
+  EXPECT_NEAR(model.locked_edge_px, shipped.locked_edge_px, 0.001 + 0.05 * shipped.locked_edge_px)
+      << "the shipped default differs from this calibration";
+  EXPECT_NEAR(model.locked_tilt_px, shipped.locked_tilt_px, 0.001 + 0.05 * shipped.locked_tilt_px)
+      << "the shipped default differs from this calibration";
+
+  const auto validation = test::locked_edge_validation_set();
+  const auto draws = draw_all(validation, 8000);
+  CornerNoiseModel without = shipped;
+  without.locked_edge_px = without.locked_tilt_px = 0;
+  std::vector<std::pair<double, int>> view_nees;
+  double sum = 0, sum_without = 0, locked = 0;
+  int n = 0, n_without = 0, edges = 0;
+  for (std::size_t i = 0; i < validation.size(); ++i) {
+    auto& [mean, count] = view_nees.emplace_back();
+    mean = mean_pose_nees(validation[i].view, draws[i], shipped, &count);
+    int count_without = 0;
+    const double mean_without = mean_pose_nees(validation[i].view, draws[i], without, &count_without);
+    sum += mean * count, n += count, sum_without += mean_without * count_without, n_without += count_without;
+    for (const ViewDraw& d : draws[i])
+      if (d.detection)
+        for (double lock : d.inputs.phase_lock) locked += lock > 0.5, ++edges;
+  }
+  ASSERT_GE(n, static_cast<int>(validation.size()) * kDraws * 8 / 10);
+  const double pooled = sum / n, clustered_se = test::clustered_standard_error(view_nees);
+  std::printf("held-out locked views: NEES %.2f over %d draws (%.2f without the locked terms); %.1f%% of "
+              "edges locked over 0.5; 99%% interval with the views as the draws [%.2f, %.2f]\n",
+              pooled, n, sum_without / n_without, 100 * locked / edges, 6 - 2.576 * clustered_se,
+              6 + 2.576 * clustered_se);
+  // The set does have locked edges (else it would judge nothing).
+  EXPECT_GE(locked / edges, 0.15);
+  // Within 2x, as every condition of the main held-out set. Not within the views' 99%
+  // interval: measured 9.2, 1.5x over-confident, all of it in sensors whose light-sensitive
+  // part is under 85% of the pixel (11.0 there, 7.2 above), which alias more than the
+  // calibration's rasterisers can show (devices/fiducial/README.md, "Limits").
+  EXPECT_GT(pooled, 3);
+  EXPECT_LT(pooled, 12) << "phase-locked edges: over 2x over-confident";
 }

@@ -3,7 +3,9 @@
 // read by the term-by-term probe (fiducial_corner_terms_probe): the calibration set the
 // corner model's defaults are fitted on (the supersampling and the exact-area rasterisers in
 // turn), and the validation set that differs from it in rasteriser (random points per
-// pixel, with a fill factor), resolution, lens, family and seed.
+// pixel, with a fill factor), resolution, lens, family and seed; and two sets of views
+// made to have phase-locked edges, held out from each other the same way.
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -99,6 +101,56 @@ inline std::vector<TagRun> validation_set(std::uint64_t seed = 23, int views_per
           runs.push_back(r);
         }
   return runs;
+}
+
+// Views with phase-locked edges (corner_noise.hpp): no pitch, the roll a whole number of
+// quarter turns within `roll_spread_deg`, so that the edges along the yaw axis lie along
+// pixel columns or rows (rows: a quarter turn); tags of 0.1-0.25 m at 0.5-2.5 m (edges of
+// about 20-300 px); hardly turned between draws (jitter under 0.06 deg), moved as usual
+// (the edges' sub-pixel phase changes from draw to draw). Lenses without distortion, which
+// would bend the edges off the pixel grid.
+inline TagRun locked_edge_view(std::mt19937_64& rng, const std::string& family, const Camera& camera,
+                               Rasteriser rasteriser, int id, double roll_spread_deg) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  TagRun r;
+  r.family = family;
+  r.view.camera = camera;
+  r.view.formation = random_formation(rng, rasteriser);
+  const double distance = 1.5 + u(rng), size = 0.175 + 0.075 * u(rng), yaw = 30 + 25 * u(rng);
+  const double roll = 90 * std::floor(2 + 2 * u(rng)) + roll_spread_deg * u(rng);
+  r.view.tag = {id, size, tag_pose(distance, yaw, 0, roll, distance * 0.15 * u(rng), distance * 0.1 * u(rng))};
+  r.view.jitter_rad = 0.001;
+  return r;
+}
+
+// 48 such views, the families and cameras in turn, each view's rasteriser from `rasteriser`.
+template <typename RasteriserOf>
+std::vector<TagRun> locked_edge_set(const std::vector<std::string>& families, const std::array<Camera, 2>& cameras,
+                                    RasteriserOf rasteriser, std::uint64_t seed, int ids, double roll_spread_deg) {
+  std::mt19937_64 rng(seed);
+  std::vector<TagRun> runs;
+  for (int i = 0; i < 48; ++i)
+    runs.push_back(locked_edge_view(rng, families[static_cast<std::size_t>(i % 4)],
+                                    cameras[static_cast<std::size_t>((i / 4) % 2)], rasteriser(i), i % ids,
+                                    roll_spread_deg));
+  return runs;
+}
+
+// The set fit_locked_edges is fitted on: the calibration set's families, cameras (without
+// the lens) and rasterisers.
+inline std::vector<TagRun> locked_edge_calibration_set() {
+  return locked_edge_set({"tag36h11", "tagStandard41h12", "tagCircle21h7", "tag16h5"},
+                         {camera(640, 480, 62), camera(1280, 720, 70)},
+                         [](int i) { return (i / 8) % 2 ? Rasteriser::AnalyticArea : Rasteriser::Supersampled; },
+                         101, 30, 0.2);
+}
+
+// Its held-out counterpart: the validation set's families, cameras (without the lens) and
+// rasteriser, another seed, and edges a little further from the grid.
+inline std::vector<TagRun> locked_edge_validation_set() {
+  return locked_edge_set({"tag25h9", "tagStandard52h13", "tagCircle49h12", "tagCustom48h12"},
+                         {camera(800, 600, 58), camera(1920, 1080, 75)},
+                         [](int) { return Rasteriser::JitteredPoints; }, 202, 25, 0.4);
 }
 
 // The pooled mean's standard error when the views are the independent draws: the spread

@@ -82,6 +82,10 @@ CornerNoise CornerNoiseModel::noise(const CornerInputs& in) const {
   // Corner k joins edges k - 1 and k.
   for (std::size_t k = 0; k < 4; ++k)
     out.extra_px[k] = shift_sigma_px * std::hypot(reach[(k + 3) % 4], reach[k]);
+  for (std::size_t e = 0; e < 4; ++e) {
+    const double lock = std::sqrt(in.phase_lock[e]);
+    out.locked_edge_px[e] = locked_edge_px * lock, out.locked_tilt_px[e] = locked_tilt_px * lock;
+  }
   return out;
 }
 
@@ -92,6 +96,7 @@ CornerInputs measure_corner_inputs(const cv::Mat& gray, const Detection& d, cons
   in.contrast = tag_contrast(gray, d.corners_px, cells);
   in.edge_length_px = mean_edge_length_px(d.corners_px);
   in.axis_alignment = edge_axis_alignment(d.corners_px);
+  in.phase_lock = edge_phase_lock(d.corners_px);
   in.blur_px = edge_blur_px(gray, d.corners_px, in.contrast);
   in.border_px = border_width_px(d.corners_px, cells);
   // The edge fit's samples straddle both sides of the edge: the mean of their variances.
@@ -279,6 +284,18 @@ double edge_axis_alignment(const std::array<cv::Point2d, 4>& c) {
     sum += std::exp(-(a / kWidthRad) * (a / kWidthRad));
   }
   return sum / 4;
+}
+
+std::array<double, 4> edge_phase_lock(const std::array<cv::Point2d, 4>& c) {
+  constexpr double kLockPx = 0.5;
+  std::array<double, 4> lock{};
+  for (std::size_t e = 0; e < 4; ++e) {
+    const cv::Point2d d = c[(e + 1) % 4] - c[e];
+    // Across the grid: the smaller of the two coordinate extents.
+    const double drift = std::min(std::abs(d.x), std::abs(d.y));
+    lock[e] = std::exp(-(drift / kLockPx) * (drift / kLockPx));
+  }
+  return lock;
 }
 
 double mean_edge_length_px(const std::array<cv::Point2d, 4>& c) {

@@ -96,6 +96,11 @@ std::vector<KeySpec> corner_model_keys() {
          "each edge's own turn (its ends' opposite outward errors), floor", 0, 100},
         {"corner_tilt_per_blur", ValueType::Float, "", "", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},
+        {"corner_locked_edge_px", ValueType::Float, "px", "", "corner noise model: spread of the "
+         "outward error of an edge that stays at one sub-pixel phase along its length (along a "
+         "pixel row or column)", 0, 100},
+        {"corner_locked_tilt_px", ValueType::Float, "px", "", "corner noise model: spread of "
+         "such an edge's turn", 0, 100},
   };
   // The defaults are CornerNoiseModel's own (corner_noise.hpp): written in one place.
   static const auto default_text = [] {
@@ -117,7 +122,8 @@ const std::vector<CornerModelField>& corner_model_fields() {
       {"corner_shift_sigma_px", &M::shift_sigma_px}, {"corner_scale_bias_per_blur", &M::scale_bias_per_blur},
       {"corner_scale_sigma_px", &M::scale_sigma_px}, {"corner_scale_per_blur", &M::scale_per_blur},
       {"corner_edge_sigma_px", &M::edge_sigma_px}, {"corner_edge_per_blur", &M::edge_per_blur},
-      {"corner_tilt_sigma_px", &M::tilt_sigma_px}, {"corner_tilt_per_blur", &M::tilt_per_blur}};
+      {"corner_tilt_sigma_px", &M::tilt_sigma_px}, {"corner_tilt_per_blur", &M::tilt_per_blur},
+      {"corner_locked_edge_px", &M::locked_edge_px}, {"corner_locked_tilt_px", &M::locked_tilt_px}};
   return fields;
 }
 

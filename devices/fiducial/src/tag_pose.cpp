@@ -111,6 +111,11 @@ Eigen::Matrix<double, 8, 8> corner_covariance(const std::array<cv::Point2d, 4>& 
   const double line2 = noise.line_sigma_px * noise.line_sigma_px;
   edges.topLeftCorner<4, 4>().diagonal().array() += line2 / 4;
   edges.bottomRightCorner<4, 4>().diagonal().array() += 3 * line2 / 4;
+  for (int e = 0; e < 4; ++e) {
+    const auto k = static_cast<std::size_t>(e);
+    edges(e, e) += noise.locked_edge_px[k] * noise.locked_edge_px[k];
+    edges(4 + e, 4 + e) += noise.locked_tilt_px[k] * noise.locked_tilt_px[k];
+  }
   Eigen::Matrix<double, 8, 8> cov = M * edges * M.transpose();
   for (int i = 0; i < 8; ++i) {
     const double extra = noise.extra_px[static_cast<std::size_t>(i / 2)];

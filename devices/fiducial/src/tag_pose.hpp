@@ -77,6 +77,8 @@ struct CornerNoise {
   double edge_sigma_px = 0;    // each edge's own outward error
   double tilt_sigma_px = 0;    // each edge's own turn: its ends' opposite outward errors
   std::array<double, 4> extra_px{};   // per corner, extra independent error (edge shift)
+  // Per edge, a phase-locked edge's own outward error and turn (corner_noise.hpp).
+  std::array<double, 4> locked_edge_px{}, locked_tilt_px{};
   EdgeShifts edge_shift_px{};  // predicted outward shifts of the edges' ends, removed
 };
 

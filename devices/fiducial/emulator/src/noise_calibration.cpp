@@ -119,13 +119,41 @@ CornerErrors corner_errors(const CornerNoiseModel& model, const ViewDraw& d) {
   return out;
 }
 
+void fit_locked_edges(CornerNoiseModel& m, const std::vector<std::vector<ViewDraw>>& views) {
+  CornerNoiseModel unlocked = m;
+  unlocked.locked_edge_px = unlocked.locked_tilt_px = 0;
+  // Per edge of every draw: lock * (error^2 - the rest of the model's variance), and lock^2.
+  double out_num = 0, turn_num = 0, den = 0;
+  for (const auto& draws : views)
+    for (const ViewDraw& d : draws) {
+      if (!d.detection) continue;
+      const auto& c = d.detection->corners_px;
+      const CornerErrors errors = corner_errors(m, d);
+      // The model's variance of each edge's outward error and turn: its corner covariance
+      // in the edges' line modes (corner_errors reads them the same way).
+      const Eigen::Matrix<double, 8, 8> to_edges = edge_line_modes(c).inverse();
+      const Eigen::Matrix<double, 8, 8> modelled =
+          to_edges * corner_covariance(c, corner_noise(unlocked, d)) * to_edges.transpose();
+      for (std::size_t e = 0; e < 4; ++e) {
+        const double lock = d.inputs.phase_lock[e];
+        const auto i = static_cast<Eigen::Index>(e);
+        out_num += lock * (errors.edge_out_px[e] * errors.edge_out_px[e] - modelled(i, i));
+        turn_num += lock * (errors.edge_turn_px[e] * errors.edge_turn_px[e] - modelled(4 + i, 4 + i));
+        den += lock * lock;
+      }
+    }
+  if (den <= 0) return;
+  m.locked_edge_px = std::sqrt(std::max(out_num / den, 0.0));
+  m.locked_tilt_px = std::sqrt(std::max(turn_num / den, 0.0));
+}
+
 std::string describe(const CornerNoiseModel& m) {
   return fmt::format("gain {:.4f}, floor {:.4f}, sample floor {:.4f}, aligned {:.4f}, shift {:.4f} (falloff {:.2f}, "
                      "sigma {:.4f}), scale bias {:.4f}/px blur, scale {:.4f} + {:.4f}/px blur, edge {:.4f} + {:.4f}/px "
-                     "blur, tilt {:.4f} + {:.4f}/px blur",
+                     "blur, tilt {:.4f} + {:.4f}/px blur, locked edge {:.4f} tilt {:.4f}",
                      m.gain_px, m.floor_px, m.sample_floor_px, m.aligned_px, m.shift_px, m.shift_falloff,
                      m.shift_sigma_px, m.scale_bias_per_blur, m.scale_sigma_px, m.scale_per_blur, m.edge_sigma_px,
-                     m.edge_per_blur, m.tilt_sigma_px, m.tilt_per_blur);
+                     m.edge_per_blur, m.tilt_sigma_px, m.tilt_per_blur, m.locked_edge_px, m.locked_tilt_px);
 }
 
 double mean_pose_nees(const CalibrationView& view,

@@ -70,6 +70,12 @@ CornerNoise corner_noise(const CornerNoiseModel& model, const ViewDraw& draw);
 CornerNoiseModel fit_corner_noise(const std::vector<CalibrationView>& views,
                                   const std::vector<std::vector<ViewDraw>>& draws);
 
+// The phase-locked edges' terms (locked_edge_px, locked_tilt_px; corner_noise.hpp) by
+// least squares of each detected edge's squared outward error and turn, less the rest of
+// `model`'s variance for them, on its lock: on views made to have such edges (few views of
+// a random set do). The other coefficients are kept.
+void fit_locked_edges(CornerNoiseModel& model, const std::vector<std::vector<ViewDraw>>& draws);
+
 // The coefficients on one line, as the calibration reports them.
 std::string describe(const CornerNoiseModel& model);
 
