@@ -301,9 +301,9 @@ TEST(FiducialBundle, NeesOfTheBundlePoseOnHeldOutRenders) {
   // Tents (a non-planar object) within both bounds. (Boards were 1.6-2.2x under-confident
   // until the image noise was measured through JPEG and the model put the line fit's
   // variance where a line fit puts it: devices/fiducial/README.md.) Flat boards within
-  // 1.5x: they read 4.83, 1.24x under-confident, just below the lower bound (4.85), since
+  // 1.5x: they read 4.78, 1.26x under-confident, just below the lower bound (4.85), since
   // the phase-locked edges' terms brought the 8 of their 60 frames that had such edges
-  // (NEES 6.6-18.1) down to 2.4-11.1; their 5.44 before leant on those frames.
+  // (NEES 6.6-18.1) down to 2.2-10.9; their 5.44 before leant on those frames.
   EXPECT_GT(sum[1] / n[1], tent_lo);
   EXPECT_GT(sum[0] / n[0], 6 / 1.5) << "flat boards over 1.5x under-confident";
   // Consistent tags are rarely called inconsistent at the default limit.

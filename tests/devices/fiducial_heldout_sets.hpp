@@ -116,6 +116,14 @@ inline TagRun locked_edge_view(std::mt19937_64& rng, const std::string& family, 
   r.family = family;
   r.view.camera = camera;
   r.view.formation = random_formation(rng, rasteriser);
+  if (rasteriser == Rasteriser::AnalyticArea) {
+    // Fill factors of 70-100% as random_formation gives the random-point rasteriser (a
+    // pixel that integrates less of its area aliases a locked edge more), from an engine
+    // of their own so that the poses stay those of the other rasterisers' views.
+    std::mt19937_64 peek = rng;
+    std::mt19937_64 own(peek() ^ 0x51ed270b27f1d3c5ULL);
+    r.view.formation.pixel_aperture = 0.7 + 0.3 * std::uniform_real_distribution<double>(0, 1)(own);
+  }
   const double distance = 1.5 + u(rng), size = 0.175 + 0.075 * u(rng), yaw = 30 + 25 * u(rng);
   const double roll = 90 * std::floor(2 + 2 * u(rng)) + roll_spread_deg * u(rng);
   r.view.tag = {id, size, tag_pose(distance, yaw, 0, roll, distance * 0.15 * u(rng), distance * 0.1 * u(rng))};
@@ -137,7 +145,7 @@ std::vector<TagRun> locked_edge_set(const std::vector<std::string>& families, co
 }
 
 // The set fit_locked_edges is fitted on: the calibration set's families, cameras (without
-// the lens) and rasterisers.
+// the lens) and rasterisers, the exact-area one with fill factors of 70-100%.
 inline std::vector<TagRun> locked_edge_calibration_set() {
   return locked_edge_set({"tag36h11", "tagStandard41h12", "tagCircle21h7", "tag16h5"},
                          {camera(640, 480, 62), camera(1280, 720, 70)},

@@ -166,3 +166,31 @@ TEST(FiducialRenderDetect, EveryRasteriserDrawsTheSameTag) {
     EXPECT_LT(worst, i == 1 ? 0.03 : 0.05) << "corners of rasteriser " << i << " differ from the exact area's";
   }
 }
+
+// A fill factor under 100%: the exact-area rasteriser integrates the pixel's sensitive
+// square only, as the random points do, and so agrees with them, not with itself at 100%.
+TEST(FiducialRenderDetect, ExactAreaAndRandomPointsAgreeOnAPartialFillFactor) {
+  const Camera cam = test::camera(640, 480, 62);
+  auto family = TagFamily::open("tag36h11");
+  ASSERT_TRUE(family.has_value());
+  const RenderedTag tag{5, 0.12, test::tag_pose(0.7, 25, 10, 33, 0.03, -0.02)};
+  ImageFormation f;
+  f.jitter_seed = 9, f.pixel_aperture = 0.7;
+  f.rasteriser = Rasteriser::AnalyticArea;
+  const cv::Mat exact = tag_radiance(cam, **family, {tag}, f);
+  f.rasteriser = Rasteriser::JitteredPoints;
+  const cv::Mat points = tag_radiance(cam, **family, {tag}, f);
+  f.rasteriser = Rasteriser::AnalyticArea, f.pixel_aperture = 1;
+  const cv::Mat whole = tag_radiance(cam, **family, {tag}, f);
+  cv::Mat to_points, to_whole;
+  cv::absdiff(exact, points, to_points);
+  cv::absdiff(exact, whole, to_whole);
+  std::printf("mean |exact - points| %.5f, |exact - exact at 100%%| %.5f\n", cv::mean(to_points)[0],
+              cv::mean(to_whole)[0]);
+  EXPECT_LT(cv::mean(to_points)[0], 0.002);
+  EXPECT_GT(cv::mean(to_whole)[0], 3 * cv::mean(to_points)[0]);
+  // Away from the edges nothing changes: the paper, the ink and the background are flat.
+  double flat_max = 0;
+  cv::minMaxLoc(to_whole(cv::Rect(0, 0, 40, 40)), nullptr, &flat_max);
+  EXPECT_EQ(flat_max, 0.0);
+}

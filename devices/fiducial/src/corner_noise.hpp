@@ -108,8 +108,8 @@ struct CornerNoiseModel {
   double tilt_per_blur = 0.0;      //   errors, px at each end): floor and growth per px blur
   // A phase-locked edge's own outward error and turn (px), at lock 1: fitted apart from the
   // rest (fit_locked_edges in noise_calibration.hpp), on views made to have such edges.
-  double locked_edge_px = 0.0647;
-  double locked_tilt_px = 0.0713;
+  double locked_edge_px = 0.0719;
+  double locked_tilt_px = 0.0806;
 
   // Per edge: exp(-shift_falloff (border / blur)^2).
   std::array<double, 4> edge_reach(const CornerInputs& in) const;

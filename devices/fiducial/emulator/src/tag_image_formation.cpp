@@ -40,15 +40,17 @@ double area(const Polygon& poly) {
   return std::abs(s) / 2;
 }
 
-// Adds value * (covered fraction) to every pixel the convex polygon touches: rows first
-// (one clip per band), then each pixel of the band.
-void add_polygon(cv::Mat& image, const Polygon& poly, float value) {
+// Adds value * (covered fraction of the pixel's light-sensitive square, `aperture` px wide
+// about its centre) to every pixel the convex polygon touches: rows first (one clip per
+// band), then each pixel of the band.
+void add_polygon(cv::Mat& image, const Polygon& poly, float value, double aperture) {
+  const double half = aperture / 2, per_area = 1 / (aperture * aperture);
   double y_lo = 1e18, y_hi = -1e18;
   for (const auto& p : poly) y_lo = std::min(y_lo, p.y), y_hi = std::max(y_hi, p.y);
   const int r0 = std::max(0, static_cast<int>(std::floor(y_lo + 0.5)));
   const int r1 = std::min(image.rows - 1, static_cast<int>(std::floor(y_hi + 0.5)));
   for (int r = r0; r <= r1; ++r) {
-    const Polygon band = clip(clip(poly, 1, r - 0.5, false), 1, r + 0.5, true);
+    const Polygon band = clip(clip(poly, 1, r - half, false), 1, r + half, true);
     if (band.size() < 3) continue;
     double x_lo = 1e18, x_hi = -1e18;
     for (const auto& p : band) x_lo = std::min(x_lo, p.x), x_hi = std::max(x_hi, p.x);
@@ -56,7 +58,7 @@ void add_polygon(cv::Mat& image, const Polygon& poly, float value) {
     const int c1 = std::min(image.cols - 1, static_cast<int>(std::floor(x_hi + 0.5)));
     float* row = image.ptr<float>(r);
     for (int c = c0; c <= c1; ++c)
-      row[c] += value * static_cast<float>(area(clip(clip(band, 0, c - 0.5, false), 0, c + 0.5, true)));
+      row[c] += value * static_cast<float>(per_area * area(clip(clip(band, 0, c - half, false), 0, c + half, true)));
   }
 }
 
@@ -93,6 +95,7 @@ std::optional<PrintedTag> printed_tag(const TagFamily& family, const RenderedTag
 cv::Mat analytic_radiance(const Camera& camera, const TagFamily& family,
                           const std::vector<RenderedTag>& tags, const ImageFormation& f) {
   cv::Mat image(camera.height_px, camera.width_px, CV_32F, cv::Scalar(f.background));
+  const double aperture = std::clamp(f.pixel_aperture, 0.05, 1.0);
   for (const RenderedTag& tag : tags) {
     const auto p = printed_tag(family, tag, std::max(0, f.margin_cells));
     if (!p) continue;
@@ -100,7 +103,7 @@ cv::Mat analytic_radiance(const Camera& camera, const TagFamily& family,
     // The paper first, then each row's runs of black cells on it. (Tags must not overlap:
     // coverage is added, not composited.)
     add_polygon(image, project_rect(camera, tag.T_camera_tag, -h, -h, h, h),
-                static_cast<float>(f.paper - f.background));
+                static_cast<float>(f.paper - f.background), aperture);
     for (int r = 0; r < p->cells.rows; ++r) {
       const std::uint8_t* row = p->cells.ptr<std::uint8_t>(r);
       for (int c = 0; c < p->cells.cols;) {
@@ -109,7 +112,7 @@ cv::Mat analytic_radiance(const Camera& camera, const TagFamily& family,
         while (end < p->cells.cols && row[end] < 128) ++end;
         const double x0 = -h + c * p->cell_m, x1 = -h + end * p->cell_m, y0 = -h + r * p->cell_m;
         add_polygon(image, project_rect(camera, tag.T_camera_tag, x0, y0, x1, y0 + p->cell_m),
-                    static_cast<float>(f.ink - f.paper));
+                    static_cast<float>(f.ink - f.paper), aperture);
         c = end;
       }
     }

@@ -23,7 +23,8 @@ enum class Rasteriser {
   // The tag's texture warped onto a grid `supersample` times finer, then area-averaged.
   Supersampled,
   // Each pixel's exact covered area of every cell, by clipping the projected cells
-  // (straight-edged quads under a pinhole) to the pixel square.
+  // (straight-edged quads under a pinhole) to the pixel's light-sensitive square
+  // (pixel_aperture).
   AnalyticArea,
   // Each pixel the mean of random points, one in each square of a 16 x 16 grid over the
   // pixel's light-sensitive part (pixel_aperture), each looked up in the tag's cells
@@ -35,7 +36,7 @@ enum class Rasteriser {
 struct ImageFormation {
   Rasteriser rasteriser = Rasteriser::AnalyticArea;
   int supersample = 4;           // Supersampled only
-  double pixel_aperture = 1.0;   // JitteredPoints only: the sensitive square's side / pitch
+  double pixel_aperture = 1.0;   // AnalyticArea, JitteredPoints: the sensitive square's side / pitch
   std::uint64_t jitter_seed = 0; // JitteredPoints only
   double paper = 0.85, ink = 0.06, background = 0.4;  // linear reflectances
   double exposure = 1.0;         // linear signal of reflectance 1, in full scale
