@@ -106,7 +106,7 @@ inline std::vector<TagRun> validation_set(std::uint64_t seed = 23, int views_per
 // Views with phase-locked edges (corner_noise.hpp): no pitch, the roll a whole number of
 // quarter turns within `roll_spread_deg`, so that the edges along the yaw axis lie along
 // pixel columns or rows (rows: a quarter turn); tags of 0.1-0.25 m at 0.5-2.5 m (edges of
-// about 20-300 px); hardly turned between draws (jitter under 0.06 deg), moved as usual
+// about 20-450 px); hardly turned between draws (jitter under 0.06 deg), moved as usual
 // (the edges' sub-pixel phase changes from draw to draw). Lenses without distortion, which
 // would bend the edges off the pixel grid.
 inline TagRun locked_edge_view(std::mt19937_64& rng, const std::string& family, const Camera& camera,
