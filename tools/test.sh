@@ -28,7 +28,7 @@ fi
 mark "instrumented build"
 tests/sanitized_tests.sh build-sanitize || failed+=(sanitized-tests)
 mark "sanitized tests"
-tests/fuzz/run_fuzzers.sh --build build-sanitize --seconds 10 || failed+=(fuzzers)
+tests/fuzz/run_fuzzers.sh --build build-sanitize --seconds 5 || failed+=(fuzzers)
 mark "fuzzers"
 if ((${#failed[@]})); then
   echo "test.sh: FAILED: ${failed[*]}" >&2
