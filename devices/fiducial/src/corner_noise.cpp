@@ -16,6 +16,11 @@ double CornerNoiseModel::sample_factor(double edge_length_px) {
   return 16.0 / std::max(16.0, edge_length_px / 8.0);
 }
 
+double CornerNoiseModel::size_factor(double edge_length_px) {
+  // Under 16 px AprilTag rarely decodes a tag; the floor keeps a degenerate length finite.
+  return 64.0 / std::max(16.0, edge_length_px);
+}
+
 double CornerNoiseModel::noise_term(double image_noise, double contrast, double edge_length_px) {
   const double ratio = image_noise / std::max(contrast, 1.0);
   return ratio * ratio * sample_factor(edge_length_px);
@@ -63,11 +68,11 @@ double CornerNoiseModel::scale_sigma(const CornerInputs& in) const {
 }
 
 double CornerNoiseModel::edge_sigma(const CornerInputs& in) const {
-  return std::hypot(edge_sigma_px, edge_per_blur * blur_or_zero(in));
+  return std::hypot(edge_sigma_px, edge_per_blur * blur_or_zero(in)) * size_factor(in.edge_length_px);
 }
 
 double CornerNoiseModel::tilt_sigma(const CornerInputs& in) const {
-  return std::hypot(tilt_sigma_px, tilt_per_blur * blur_or_zero(in));
+  return std::hypot(tilt_sigma_px, tilt_per_blur * blur_or_zero(in)) * size_factor(in.edge_length_px);
 }
 
 CornerNoise CornerNoiseModel::noise(const CornerInputs& in) const {

@@ -52,8 +52,11 @@
 // edge's line is placed off by its own error (edge_sigma, shared by the edge's two
 // corners), turned by its own error (tilt_sigma: its two ends off in opposite senses)
 // and all four edges by a common one (scale_sigma: the square looks too large or
-// too small, which moves the pose along the line of sight). Both grow with the measured
-// blur: sigma = hypot(floor, per_blur * blur). Their mean is not zero: a tone curve that
+// too small, which moves the pose along the line of sight). Each grows with the measured
+// blur: sigma = hypot(floor, per_blur * blur); an edge's own placement and turn also fall
+// with its length, as 64 px / L (size_factor: measured on rendered views, the turns of
+// edges under 50 px were 4.5x a constant spread's, of 80-120 px 2.5x, and the constant
+// spread was their average). Their mean is not zero: a tone curve that
 // lifts the mid-tones (gamma above 1, as in sRGB) grows the light side into the dark one
 // (0.35-0.45 px per px of blur at gamma 2.2), so a dark square looks smaller and a light one (reversed-border
 // families) larger. scale_bias_per_blur * blur, signed by the polarity, is moved out of
@@ -91,25 +94,25 @@ struct CornerInputs {
 // population (tone curves gamma 1-2.4, blur 0.4-1.25 px plus defocus, JPEG 75-97 or none;
 // devices/fiducial/README.md); config/schema.md lists the same values.
 struct CornerNoiseModel {
-  double gain_px = 1.1980;
-  double floor_px = 0.0163;         // independent of the tag's size
-  double sample_floor_px = 0.0308;  // per edge sample: averaged by the edge fit (above)
-  double aligned_px = 0.0293;
-  double shift_px = 1.7258;        // outward edge shift with all-white cells inside, zero border
-  double shift_falloff = 0.20;     // how fast it fades with border / blur (see above)
-  double shift_sigma_px = 1.5849;  // the shift correction's uncertainty at reach 1
-  double scale_bias_per_blur = -0.2592;  // every edge's mean outward error per px of blur,
+  double gain_px = 1.2299;
+  double floor_px = 0.0001;         // independent of the tag's size
+  double sample_floor_px = 0.0368;  // per edge sample: averaged by the edge fit (above)
+  double aligned_px = 0.0141;
+  double shift_px = 2.1957;        // outward edge shift with all-white cells inside, zero border
+  double shift_falloff = 0.21;     // how fast it fades with border / blur (see above)
+  double shift_sigma_px = 1.8642;  // the shift correction's uncertainty at reach 1
+  double scale_bias_per_blur = -0.2574;  // every edge's mean outward error per px of blur,
                                          // for a dark square (a light one: the opposite)
-  double scale_sigma_px = 0.0245;     // the four edges' common outward error: its floor
-  double scale_per_blur = 0.1301;  //   and its growth per px of edge blur
-  double edge_sigma_px = 0.0157;   // each edge's own outward error: its floor
+  double scale_sigma_px = 0.0258;     // the four edges' common outward error: its floor
+  double scale_per_blur = 0.1331;  //   and its growth per px of edge blur
+  double edge_sigma_px = 0.0108;   // each edge's own outward error at 64 px: its floor
   double edge_per_blur = 0.0;      //   and its growth per px of edge blur
-  double tilt_sigma_px = 0.0105;   // each edge's own turn (its ends' opposite outward
+  double tilt_sigma_px = 0.0124;   // each edge's own turn at 64 px (its ends' opposite outward
   double tilt_per_blur = 0.0;      //   errors, px at each end): floor and growth per px blur
   // A phase-locked edge's own outward error and turn (px), at lock 1: fitted apart from the
   // rest (fit_locked_edges in noise_calibration.hpp), on views made to have such edges.
-  double locked_edge_px = 0.0719;
-  double locked_tilt_px = 0.0806;
+  double locked_edge_px = 0.0661;
+  double locked_tilt_px = 0.0797;
 
   // Per edge: exp(-shift_falloff (border / blur)^2).
   std::array<double, 4> edge_reach(const CornerInputs& in) const;
@@ -130,6 +133,9 @@ struct CornerNoiseModel {
   CornerNoise noise(const CornerInputs& in) const;
   // How the edge fit averages its samples' errors: 16 / max(16, L / 8).
   static double sample_factor(double edge_length_px);
+  // How an edge's own placement and turn spreads scale with its length: 64 / max(16, L),
+  // so edge_sigma_px and tilt_sigma_px (and their growth per blur) are those at 64 px.
+  static double size_factor(double edge_length_px);
   // The noise-driven factor the gain multiplies: (noise / contrast)^2 * sample_factor(L).
   static double noise_term(double image_noise, double contrast, double edge_length_px);
 };

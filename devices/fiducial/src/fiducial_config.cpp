@@ -89,11 +89,12 @@ std::vector<KeySpec> corner_model_keys() {
         {"corner_scale_per_blur", ValueType::Float, "", "", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},
         {"corner_edge_sigma_px", ValueType::Float, "px", "", "corner noise model: spread of each "
-         "edge's own outward error, floor", 0, 100},
+         "edge's own outward error, floor, for a 64 px edge (both terms scale as 64 / length)", 0, 100},
         {"corner_edge_per_blur", ValueType::Float, "", "", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},
         {"corner_tilt_sigma_px", ValueType::Float, "px", "", "corner noise model: spread of "
-         "each edge's own turn (its ends' opposite outward errors), floor", 0, 100},
+         "each edge's own turn (its ends' opposite outward errors), floor, for a 64 px edge (both "
+         "terms scale as 64 / length)", 0, 100},
         {"corner_tilt_per_blur", ValueType::Float, "", "", "corner noise model: that spread's "
          "growth per px of edge blur", 0, 100},
         {"corner_locked_edge_px", ValueType::Float, "px", "", "corner noise model: spread of the "

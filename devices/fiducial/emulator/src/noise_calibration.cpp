@@ -343,21 +343,21 @@ double log_search(Vec& c, const Cost& cost_of, double tiny) {
   return best;
 }
 
-// floor^2 + (per_blur * blur)^2 through points (blur, variance) by non-negative least
-// squares on [1, blur^2].
-std::pair<double, double> fit_floor_and_growth(const std::vector<std::pair<double, double>>& points) {
+// x * (floor^2 + (per_blur * blur)^2) through points (blur, variance, x) by non-negative
+// least squares on [x, x blur^2] (x: how the spread scales with the view, 1 if it does not).
+std::pair<double, double> fit_floor_and_growth(const std::vector<std::array<double, 3>>& points) {
   if (points.empty()) return {0, 0};
   Eigen::MatrixXd A(static_cast<Eigen::Index>(points.size()), 2);
   Eigen::VectorXd b(A.rows());
   for (Eigen::Index i = 0; i < A.rows(); ++i) {
-    const auto& [blur, variance] = points[static_cast<std::size_t>(i)];
-    A(i, 0) = 1, A(i, 1) = blur * blur, b(i) = variance;
+    const auto& [blur, variance, x] = points[static_cast<std::size_t>(i)];
+    A(i, 0) = x, A(i, 1) = x * blur * blur, b(i) = variance;
   }
-  Eigen::Vector2d x = A.colPivHouseholderQr().solve(b);
+  Eigen::Vector2d c = A.colPivHouseholderQr().solve(b);
   // A negative coefficient: the other one alone.
-  if (x[0] < 0) x = {0, std::max(0.0, A.col(1).dot(b) / A.col(1).squaredNorm())};
-  if (x[1] < 0) x = {std::max(0.0, b.mean()), 0};
-  return {std::sqrt(x[0]), std::sqrt(x[1])};
+  if (c[0] < 0) c = {0, std::max(0.0, A.col(1).dot(b) / A.col(1).squaredNorm())};
+  if (c[1] < 0) c = {std::max(0.0, A.col(0).dot(b) / A.col(0).squaredNorm()), 0};
+  return {std::sqrt(c[0]), std::sqrt(c[1])};
 }
 
 // Stage 3: each view's mean outward error per edge (after the edge shift's correction)
@@ -365,17 +365,20 @@ std::pair<double, double> fit_floor_and_growth(const std::vector<std::pair<doubl
 // part's mean square is scale_sigma^2 and the rest's is 3/4 of edge_sigma^2 (the common
 // part took one quarter of each edge's own); each edge's mean turn (half its start's
 // minus its end's error) has tilt_sigma^2. The means' sampling variance, from the
-// draw-to-draw spread, is taken off.
+// draw-to-draw spread, is taken off. The edge and turn spreads are fitted at 64 px: each
+// view's points weighted by CornerNoiseModel::size_factor of its mean edge length, squared.
 void fit_systematic_terms(CornerNoiseModel& m, const ErrorsByView& views) {
-  std::vector<std::pair<double, double>> scale_points, edge_points, tilt_points;
+  std::vector<std::array<double, 3>> scale_points, edge_points, tilt_points;
   for (const auto& view : views) {
     std::vector<CornerErrors> errors;
-    double blur = 0;
+    double blur = 0, length = 0;
     for (const DrawErrors& de : view)
-      if (std::isfinite(de.draw->inputs.blur_px)) errors.push_back(de.errors), blur += de.draw->inputs.blur_px;
+      if (std::isfinite(de.draw->inputs.blur_px))
+        errors.push_back(de.errors), blur += de.draw->inputs.blur_px, length += de.draw->inputs.edge_length_px;
     const double n = static_cast<double>(errors.size());
     if (n < 3) continue;
-    blur /= n;
+    blur /= n, length /= n;
+    const double x = std::pow(CornerNoiseModel::size_factor(length), 2);
     // Per edge: the mean over draws and the variance of one draw, of the outward error
     // (out) and the turn.
     std::array<double, 4> out{}, out_var{}, turn{}, turn_var{};
@@ -388,13 +391,13 @@ void fit_systematic_terms(CornerNoiseModel& m, const ErrorsByView& views) {
       }
     const double common = (out[0] + out[1] + out[2] + out[3]) / 4;
     const double mean_var = (out_var[0] + out_var[1] + out_var[2] + out_var[3]) / 4;
-    scale_points.emplace_back(blur, common * common - mean_var / (4 * n));
+    scale_points.push_back({blur, common * common - mean_var / (4 * n), 1});
     double rest = 0, turn_sq = 0, turn_mean_var = 0;
     for (std::size_t k = 0; k < 4; ++k)
       rest += (out[k] - common) * (out[k] - common) / 4, turn_sq += turn[k] * turn[k] / 4,
           turn_mean_var += turn_var[k] / 4;
-    edge_points.emplace_back(blur, (rest - 0.75 * mean_var / n) * 4 / 3);
-    tilt_points.emplace_back(blur, turn_sq - turn_mean_var / n);
+    edge_points.push_back({blur, (rest - 0.75 * mean_var / n) * 4 / 3, x});
+    tilt_points.push_back({blur, turn_sq - turn_mean_var / n, x});
   }
   std::tie(m.scale_sigma_px, m.scale_per_blur) = fit_floor_and_growth(scale_points);
   std::tie(m.edge_sigma_px, m.edge_per_blur) = fit_floor_and_growth(edge_points);

@@ -54,7 +54,8 @@ struct ImageFormation {
   cv::Mat true_distortion;
 };
 
-// The linear radiance of the tags over a flat background (CV_32F), sharp, pinhole.
+// The linear radiance of the tags over a flat background (CV_32F), sharp: pinhole, or
+// through the lens of formation.true_distortion, each pixel the mean over its footprint.
 cv::Mat tag_radiance(const Camera& camera, const TagFamily& family,
                      const std::vector<RenderedTag>& tags, const ImageFormation& formation);
 
