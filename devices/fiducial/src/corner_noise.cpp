@@ -11,6 +11,13 @@
 
 namespace covtrack::fiducial {
 
+namespace {
+// An edge's turn stays locked over more drift than its placement (corner_noise.hpp): the
+// calibration's locked views under-model turns 2.4-3.2x at 0.5-2 px of drift with the
+// placement's 0.5 px, 1.2-1.7x with 1.5 px, and nothing beyond 2 px.
+constexpr double kTurnLockPx = 1.5;
+}  // namespace
+
 double CornerNoiseModel::sample_factor(double edge_length_px) {
   // AprilTag 3's refine_edges samples each edge at max(16, L / 8) points.
   return 16.0 / std::max(16.0, edge_length_px / 8.0);
@@ -88,8 +95,8 @@ CornerNoise CornerNoiseModel::noise(const CornerInputs& in) const {
   for (std::size_t k = 0; k < 4; ++k)
     out.extra_px[k] = shift_sigma_px * std::hypot(reach[(k + 3) % 4], reach[k]);
   for (std::size_t e = 0; e < 4; ++e) {
-    const double lock = std::sqrt(in.phase_lock[e]);
-    out.locked_edge_px[e] = locked_edge_px * lock, out.locked_tilt_px[e] = locked_tilt_px * lock;
+    out.locked_edge_px[e] = locked_edge_px * std::sqrt(in.phase_lock[e]);
+    out.locked_tilt_px[e] = locked_tilt_px * std::sqrt(in.turn_lock[e]);
   }
   return out;
 }
@@ -102,6 +109,7 @@ CornerInputs measure_corner_inputs(const cv::Mat& gray, const Detection& d, cons
   in.edge_length_px = mean_edge_length_px(d.corners_px);
   in.axis_alignment = edge_axis_alignment(d.corners_px);
   in.phase_lock = edge_phase_lock(d.corners_px);
+  in.turn_lock = edge_phase_lock(d.corners_px, kTurnLockPx);
   in.blur_px = edge_blur_px(gray, d.corners_px, in.contrast);
   in.border_px = border_width_px(d.corners_px, cells);
   // The edge fit's samples straddle both sides of the edge: the mean of their variances.
@@ -291,14 +299,13 @@ double edge_axis_alignment(const std::array<cv::Point2d, 4>& c) {
   return sum / 4;
 }
 
-std::array<double, 4> edge_phase_lock(const std::array<cv::Point2d, 4>& c) {
-  constexpr double kLockPx = 0.5;
+std::array<double, 4> edge_phase_lock(const std::array<cv::Point2d, 4>& c, double width_px) {
   std::array<double, 4> lock{};
   for (std::size_t e = 0; e < 4; ++e) {
     const cv::Point2d d = c[(e + 1) % 4] - c[e];
     // Across the grid: the smaller of the two coordinate extents.
     const double drift = std::min(std::abs(d.x), std::abs(d.y));
-    lock[e] = std::exp(-(drift / kLockPx) * (drift / kLockPx));
+    lock[e] = std::exp(-(drift / width_px) * (drift / width_px));
   }
   return lock;
 }

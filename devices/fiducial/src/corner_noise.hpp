@@ -29,9 +29,12 @@
 // how far the edge drifts across the pixel grid from one end to the other, D = L_e
 // |sin(angle to the nearest axis)| (px), not the angle: a 45 px edge at 0.3 deg drifts
 // 0.24 px and is locked, a 150 px one at the same angle is not. Per edge, lock =
-// exp(-(D / 0.5 px)^2); its line's outward error gains locked_edge_px^2 * lock and its turn
-// locked_tilt_px^2 * lock (measured on rendered views: 0.1 px outward, 0.08 px turn for
-// edges under 0.25 px of drift, against 0.02 and 0.03 px beyond 1 px).
+// exp(-(D / 0.5 px)^2); its line's outward error gains locked_edge_px^2 * lock (measured on
+// rendered views: 0.1 px outward for edges under 0.25 px of drift, 0.02 px beyond 1 px).
+// The turn stays locked longer: an edge that sweeps about one pixel phase cycle along its
+// length gets an interpolation error that rises along it, which a line fit takes as a
+// turn, and averages only beyond ~2 cycles; its turn gains locked_tilt_px^2 *
+// exp(-(D / 1.5 px)^2) (turn_lock).
 //
 // Edge shift: the black border is one cell thick; where a white data cell lines its
 // inside, the blurred image rises again within a few pixels of the edge, and AprilTag's
@@ -83,6 +86,7 @@ struct CornerInputs {
   double edge_length_px = 0;  // mean edge length
   double axis_alignment = 0;  // A (edge_axis_alignment)
   std::array<double, 4> phase_lock{};  // per edge (edge_phase_lock)
+  std::array<double, 4> turn_lock{};   // per edge, the turn's (edge_phase_lock, 1.5 px wide)
   double blur_px = 1;         // edge_blur_px
   std::array<double, 4> border_px{};   // per edge: the black border's width (border_width_px)
   std::array<std::array<double, 2>, 4> inner_white{};  // per edge, at its start and end:
@@ -112,7 +116,7 @@ struct CornerNoiseModel {
   // A phase-locked edge's own outward error and turn (px), at lock 1: fitted apart from the
   // rest (fit_locked_edges in noise_calibration.hpp), on views made to have such edges.
   double locked_edge_px = 0.0661;
-  double locked_tilt_px = 0.0797;
+  double locked_tilt_px = 0.0807;
 
   // Per edge: exp(-shift_falloff (border / blur)^2).
   std::array<double, 4> edge_reach(const CornerInputs& in) const;
@@ -183,9 +187,9 @@ double edge_blur_px(const cv::Mat& gray, const std::array<cv::Point2d, 4>& corne
 // A in the model above: 1 when every edge lies along a pixel row or column, ~0 beyond 6 deg.
 double edge_axis_alignment(const std::array<cv::Point2d, 4>& corners_px);
 
-// Per edge, how much its sub-pixel phase stays the same along it: exp(-(D / 0.5 px)^2),
-// D its drift across the pixel grid (see the model above).
-std::array<double, 4> edge_phase_lock(const std::array<cv::Point2d, 4>& corners_px);
+// Per edge, how much its sub-pixel phase stays the same along it: exp(-(D / width)^2),
+// D its drift across the pixel grid (see the model above; the turn's lock is wider).
+std::array<double, 4> edge_phase_lock(const std::array<cv::Point2d, 4>& corners_px, double width_px = 0.5);
 
 double mean_edge_length_px(const std::array<cv::Point2d, 4>& corners_px);
 

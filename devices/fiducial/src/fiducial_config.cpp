@@ -101,7 +101,7 @@ std::vector<KeySpec> corner_model_keys() {
          "outward error of an edge that stays at one sub-pixel phase along its length (along a "
          "pixel row or column)", 0, 100},
         {"corner_locked_tilt_px", ValueType::Float, "px", "", "corner noise model: spread of "
-         "such an edge's turn", 0, 100},
+         "such an edge's turn (which stays locked over up to ~2 px of drift across the grid)", 0, 100},
   };
   // The defaults are CornerNoiseModel's own (corner_noise.hpp): written in one place.
   static const auto default_text = [] {

@@ -123,7 +123,7 @@ void fit_locked_edges(CornerNoiseModel& m, const std::vector<std::vector<ViewDra
   CornerNoiseModel unlocked = m;
   unlocked.locked_edge_px = unlocked.locked_tilt_px = 0;
   // Per edge of every draw: lock * (error^2 - the rest of the model's variance), and lock^2.
-  double out_num = 0, turn_num = 0, den = 0;
+  double out_num = 0, turn_num = 0, den = 0, turn_den = 0;
   for (const auto& draws : views)
     for (const ViewDraw& d : draws) {
       if (!d.detection) continue;
@@ -138,13 +138,14 @@ void fit_locked_edges(CornerNoiseModel& m, const std::vector<std::vector<ViewDra
         const double lock = d.inputs.phase_lock[e];
         const auto i = static_cast<Eigen::Index>(e);
         out_num += lock * (errors.edge_out_px[e] * errors.edge_out_px[e] - modelled(i, i));
-        turn_num += lock * (errors.edge_turn_px[e] * errors.edge_turn_px[e] - modelled(4 + i, 4 + i));
-        den += lock * lock;
+        const double turn_lock = d.inputs.turn_lock[e];
+        turn_num += turn_lock * (errors.edge_turn_px[e] * errors.edge_turn_px[e] - modelled(4 + i, 4 + i));
+        den += lock * lock, turn_den += turn_lock * turn_lock;
       }
     }
   if (den <= 0) return;
   m.locked_edge_px = std::sqrt(std::max(out_num / den, 0.0));
-  m.locked_tilt_px = std::sqrt(std::max(turn_num / den, 0.0));
+  m.locked_tilt_px = std::sqrt(std::max(turn_num / turn_den, 0.0));
 }
 
 std::string describe(const CornerNoiseModel& m) {
