@@ -1,7 +1,9 @@
 #include "covtrack/emulators/fiducial/tag_image_formation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include <opencv2/calib3d.hpp>
@@ -13,52 +15,83 @@ namespace {
 
 using Polygon = std::vector<cv::Point2d>;
 
+// A convex polygon of at most a quad clipped by four axis-aligned half-planes (at most 8
+// vertices), held without allocating: the exact-area rasteriser clips millions of them.
+struct SmallPolygon {
+  std::array<cv::Point2d, 12> p;
+  std::size_t n = 0;
+};
+
 // Sutherland-Hodgman against one axis-aligned half-plane: keeps the points whose
 // coordinate `axis` (0: x, 1: y) is <= bound (keep_below) or >= bound.
-Polygon clip(const Polygon& poly, int axis, double bound, bool keep_below) {
-  Polygon out;
+SmallPolygon clip(const SmallPolygon& poly, int axis, double bound, bool keep_below) {
+  SmallPolygon out;
   const auto inside = [&](const cv::Point2d& p) {
     const double c = axis == 0 ? p.x : p.y;
     return keep_below ? c <= bound : c >= bound;
   };
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    const cv::Point2d& a = poly[i];
-    const cv::Point2d& b = poly[(i + 1) % poly.size()];
+  for (std::size_t i = 0; i < poly.n; ++i) {
+    const cv::Point2d& a = poly.p[i];
+    const cv::Point2d& b = poly.p[(i + 1) % poly.n];
     const bool ia = inside(a), ib = inside(b);
-    if (ia) out.push_back(a);
+    if (ia) out.p[out.n++] = a;
     if (ia != ib) {
       const double ca = axis == 0 ? a.x : a.y, cb = axis == 0 ? b.x : b.y;
-      out.push_back(a + (b - a) * ((bound - ca) / (cb - ca)));
+      out.p[out.n++] = a + (b - a) * ((bound - ca) / (cb - ca));
     }
   }
   return out;
 }
 
-double area(const Polygon& poly) {
+double area(const SmallPolygon& poly) {
   double s = 0;
-  for (std::size_t i = 0; i < poly.size(); ++i) s += poly[i].cross(poly[(i + 1) % poly.size()]);
+  for (std::size_t i = 0; i < poly.n; ++i) s += poly.p[i].cross(poly.p[(i + 1) % poly.n]);
   return std::abs(s) / 2;
 }
 
+// The x-range over which the band [y - half, y + half] of a convex polygon covers the
+// band's whole height: where its left boundary's larger and its right boundary's smaller
+// end lie (both are at the band's top or bottom, the boundaries being convex). Empty when
+// the polygon does not reach both.
+std::pair<double, double> full_height_span(const SmallPolygon& band, double top, double bottom) {
+  constexpr double kOnLinePx = 1e-9;
+  double top_lo = 1e18, top_hi = -1e18, bottom_lo = 1e18, bottom_hi = -1e18;
+  for (std::size_t i = 0; i < band.n; ++i) {
+    const cv::Point2d& q = band.p[i];
+    if (std::abs(q.y - top) <= kOnLinePx) top_lo = std::min(top_lo, q.x), top_hi = std::max(top_hi, q.x);
+    if (std::abs(q.y - bottom) <= kOnLinePx) bottom_lo = std::min(bottom_lo, q.x), bottom_hi = std::max(bottom_hi, q.x);
+  }
+  return {std::max(top_lo, bottom_lo), std::min(top_hi, bottom_hi)};
+}
+
 // Adds value * (covered fraction of the pixel's light-sensitive square, `aperture` px wide
-// about its centre) to every pixel the convex polygon touches: rows first (one clip per
-// band), then each pixel of the band.
-void add_polygon(cv::Mat& image, const Polygon& poly, float value, double aperture) {
+// about its centre) to every pixel the convex polygon (a quad) touches: rows first (one
+// clip per band), then each pixel of the band; a pixel whose square lies where the band is
+// covered over its whole height is covered whole, without clipping.
+void add_polygon(cv::Mat& image, const Polygon& quad, float value, double aperture) {
   const double half = aperture / 2, per_area = 1 / (aperture * aperture);
+  SmallPolygon poly;
+  for (const auto& q : quad) poly.p[poly.n++] = q;
   double y_lo = 1e18, y_hi = -1e18;
-  for (const auto& p : poly) y_lo = std::min(y_lo, p.y), y_hi = std::max(y_hi, p.y);
+  for (const auto& p : quad) y_lo = std::min(y_lo, p.y), y_hi = std::max(y_hi, p.y);
   const int r0 = std::max(0, static_cast<int>(std::floor(y_lo + 0.5)));
   const int r1 = std::min(image.rows - 1, static_cast<int>(std::floor(y_hi + 0.5)));
   for (int r = r0; r <= r1; ++r) {
-    const Polygon band = clip(clip(poly, 1, r - half, false), 1, r + half, true);
-    if (band.size() < 3) continue;
+    const SmallPolygon band = clip(clip(poly, 1, r - half, false), 1, r + half, true);
+    if (band.n < 3) continue;
     double x_lo = 1e18, x_hi = -1e18;
-    for (const auto& p : band) x_lo = std::min(x_lo, p.x), x_hi = std::max(x_hi, p.x);
+    for (std::size_t i = 0; i < band.n; ++i) x_lo = std::min(x_lo, band.p[i].x), x_hi = std::max(x_hi, band.p[i].x);
+    const auto [full_lo, full_hi] = full_height_span(band, r - half, r + half);
     const int c0 = std::max(0, static_cast<int>(std::floor(x_lo + 0.5)));
     const int c1 = std::min(image.cols - 1, static_cast<int>(std::floor(x_hi + 0.5)));
     float* row = image.ptr<float>(r);
-    for (int c = c0; c <= c1; ++c)
+    for (int c = c0; c <= c1; ++c) {
+      if (c - half >= full_lo && c + half <= full_hi) {
+        row[c] += value;
+        continue;
+      }
       row[c] += value * static_cast<float>(per_area * area(clip(clip(band, 0, c - half, false), 0, c + half, true)));
+    }
   }
 }
 
@@ -125,15 +158,19 @@ cv::Mat analytic_radiance(const Camera& camera, const TagFamily& family,
 struct LensMap {
   const cv::Mat* ideal_at = nullptr;  // CV_32FC2: the pinhole point each pixel's centre sees
 
-  // The pinhole point at offset (dx, dy) px from the centre of pixel (c, r).
-  cv::Point2d ideal(int c, int r, double dx, double dy) const {
-    if (!ideal_at) return {c + dx, r + dy};
+  // Pixel (c, r)'s neighbourhood: the pinhole point at offset (dx, dy) px from its centre.
+  // Read once per pixel, used for every sample in it.
+  struct Pixel {
+    cv::Point2d centre, du, dv;
+    cv::Point2d ideal(double dx, double dy) const { return centre + du * dx + dv * dy; }
+  };
+  Pixel pixel(int c, int r) const {
+    if (!ideal_at) return {cv::Point2d(c, r), cv::Point2d(1, 0), cv::Point2d(0, 1)};
     const auto at = [&](int cc, int rr) {
       const cv::Vec2f v = ideal_at->at<cv::Vec2f>(std::clamp(rr, 0, ideal_at->rows - 1), std::clamp(cc, 0, ideal_at->cols - 1));
       return cv::Point2d(v[0], v[1]);
     };
-    const cv::Point2d du = (at(c + 1, r) - at(c - 1, r)) / 2, dv = (at(c, r + 1) - at(c, r - 1)) / 2;
-    return at(c, r) + du * dx + dv * dy;
+    return {at(c, r), (at(c + 1, r) - at(c - 1, r)) / 2, (at(c, r + 1) - at(c, r - 1)) / 2};
   }
 };
 
@@ -169,8 +206,9 @@ cv::Mat jittered_radiance(const Camera& camera, const TagFamily& family,
     for (int r = box.y; r < box.y + box.height; ++r) {
       float* row = image.ptr<float>(r);
       for (int c = box.x; c < box.x + box.width; ++c) {
+        const LensMap::Pixel seen = lens.pixel(c, r);
         const auto cell_seen = [&](double dx, double dy) {
-          const cv::Point2d q = lens.ideal(c, r, dx, dy);
+          const cv::Point2d q = seen.ideal(dx, dy);
           return cell_at(q.x, q.y);
         };
         // A sensitive square whose four corners lie in one cell lies in it whole (a
@@ -278,14 +316,15 @@ cv::Mat fine_lens_radiance(const Camera& camera, const TagFamily& family, const 
     // fine pixels (x_fine = kFine x + (kFine - 1) / 2).
     cv::Mat fine_at(box.size() * kFine, CV_32FC2);
     for (int r = 0; r < box.height; ++r)
-      for (int c = 0; c < box.width; ++c)
+      for (int c = 0; c < box.width; ++c) {
+        const LensMap::Pixel seen = lens.pixel(box.x + c, box.y + r);
         for (int i = 0; i < kFine; ++i)
           for (int j = 0; j < kFine; ++j) {
-            const cv::Point2d q = lens.ideal(box.x + c, box.y + r, aperture * ((j + 0.5) / kFine - 0.5),
-                                             aperture * ((i + 0.5) / kFine - 0.5));
+            const cv::Point2d q = seen.ideal(aperture * ((j + 0.5) / kFine - 0.5), aperture * ((i + 0.5) / kFine - 0.5));
             fine_at.at<cv::Vec2f>(r * kFine + i, c * kFine + j) =
                 cv::Vec2f(static_cast<float>(kFine * q.x + (kFine - 1) / 2.0), static_cast<float>(kFine * q.y + (kFine - 1) / 2.0));
           }
+      }
     std::vector<cv::Mat> xy;
     cv::split(fine_at, xy);
     double x_lo, x_hi, y_lo, y_hi;
@@ -334,7 +373,11 @@ cv::Mat disk_kernel(double radius) {
 
 }  // namespace
 
-double pixel_coverage(const std::vector<cv::Point2d>& poly, int x, int y) {
+double pixel_coverage(const std::vector<cv::Point2d>& polygon, int x, int y) {
+  // Four clips add at most four vertices: 8 + 4 fit SmallPolygon.
+  if (polygon.size() > 8) return std::numeric_limits<double>::quiet_NaN();
+  SmallPolygon poly;
+  for (const auto& q : polygon) poly.p[poly.n++] = q;
   return area(clip(clip(clip(clip(poly, 1, y - 0.5, false), 1, y + 0.5, true), 0, x - 0.5, false),
                    0, x + 0.5, true));
 }

@@ -64,7 +64,8 @@ cv::Mat form_image(const Camera& camera, const TagFamily& family,
                    const std::vector<RenderedTag>& tags, const ImageFormation& formation,
                    std::mt19937_64& rng);
 
-// The fraction of the unit pixel square centred on (x, y) that the convex polygon covers.
+// The fraction of the unit pixel square centred on (x, y) that the convex polygon (up to 8
+// vertices; NaN for more) covers.
 double pixel_coverage(const std::vector<cv::Point2d>& convex_polygon, int x, int y);
 
 }  // namespace covtrack::fiducial
