@@ -15,8 +15,9 @@ namespace {
 
 using Polygon = std::vector<cv::Point2d>;
 
-// A convex polygon of at most a quad clipped by four axis-aligned half-planes (at most 8
-// vertices), held without allocating: the exact-area rasteriser clips millions of them.
+// A convex polygon clipped by axis-aligned half-planes, held without allocating (the
+// exact-area rasteriser clips millions of them): a quad clipped four times has at most 8
+// vertices, and pixel_coverage's polygons of up to 8 at most 12.
 struct SmallPolygon {
   std::array<cv::Point2d, 12> p;
   std::size_t n = 0;
@@ -306,12 +307,21 @@ cv::Mat fine_lens_radiance(const Camera& camera, const TagFamily& family, const 
   ImageFormation pinhole = f;
   pinhole.supersample = 1;     // the area averaging below is the supersampling
   pinhole.pixel_aperture = 1;  // and the fine pixels' sensitive square, the whole fine pixel
+  // Each tag's pixels (empty when it is not drawn): a box is rendered from the tags that
+  // reach it only, not from every tag of the frame.
+  std::vector<cv::Rect> boxes;
   for (const RenderedTag& tag : tags) {
     const auto p = printed_tag(family, tag, std::max(0, f.margin_cells));
-    if (!p) continue;
-    const double h = p->half_m;
-    const cv::Rect box = pixels_seeing(camera, f.true_distortion, project_rect(camera, tag.T_camera_tag, -h, -h, h, h));
+    boxes.push_back(p ? pixels_seeing(camera, f.true_distortion,
+                                      project_rect(camera, tag.T_camera_tag, -p->half_m, -p->half_m, p->half_m, p->half_m))
+                      : cv::Rect());
+  }
+  std::vector<RenderedTag> reaching;
+  for (const cv::Rect& box : boxes) {
     if (box.empty()) continue;
+    reaching.clear();
+    for (std::size_t j = 0; j < tags.size(); ++j)
+      if (!(boxes[j] & box).empty()) reaching.push_back(tags[j]);
     // Each sub-sample's pinhole point, kFine x kFine over each pixel's sensitive square, in
     // fine pixels (x_fine = kFine x + (kFine - 1) / 2).
     cv::Mat fine_at(box.size() * kFine, CV_32FC2);
@@ -337,7 +347,7 @@ cv::Mat fine_lens_radiance(const Camera& camera, const TagFamily& family, const 
     fine.width_px = static_cast<int>(std::ceil(x_hi)) + 3 - x0, fine.height_px = static_cast<int>(std::ceil(y_hi)) + 3 - y0;
     fine_at -= cv::Scalar(x0, y0);
     cv::Mat seen, averaged;
-    cv::remap(pinhole_radiance(fine, family, tags, pinhole), seen, fine_at, cv::noArray(), cv::INTER_LINEAR,
+    cv::remap(pinhole_radiance(fine, family, reaching, pinhole), seen, fine_at, cv::noArray(), cv::INTER_LINEAR,
               cv::BORDER_REPLICATE);
     cv::resize(seen, averaged, box.size(), 0, 0, cv::INTER_AREA);
     averaged.copyTo(image(box));
