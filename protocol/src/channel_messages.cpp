@@ -6,16 +6,13 @@
 
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/wire_text.hpp"
+#include "rejection.hpp"
 
 namespace covtrack {
 namespace {
 
 constexpr std::int64_t kMinHeartbeatPeriodUs = 1'000;
 constexpr std::int64_t kMaxHeartbeatPeriodUs = 3'600'000'000;
-
-std::unexpected<WireRejection> reject(WireFault fault, std::string detail) {
-  return std::unexpected(WireRejection{fault, std::move(detail)});
-}
 
 std::unexpected<WireRejection> bad_channel(std::string_view channel, std::string_view shape) {
   return reject(WireFault::BadChannel, fmt::format("channel '{}' is not {} with names of 1-{} characters "

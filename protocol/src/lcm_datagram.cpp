@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "rejection.hpp"
+
 namespace covtrack::lcm_wire {
 namespace {
 
@@ -12,10 +14,6 @@ std::uint32_t be32(const std::byte* p) {
          std::uint32_t(p[3]);
 }
 std::uint16_t be16(const std::byte* p) { return static_cast<std::uint16_t>((std::uint32_t(p[0]) << 8) | std::uint32_t(p[1])); }
-
-std::unexpected<DatagramRejection> reject(DatagramFault fault, std::string detail) {
-  return std::unexpected(DatagramRejection{fault, std::move(detail)});
-}
 
 // The NUL-terminated channel at the start of `rest`; what follows it is the data.
 std::expected<std::string_view, DatagramRejection> channel_at(std::span<const std::byte> rest) {

@@ -5,12 +5,9 @@
 
 #include <fmt/format.h>
 
+#include "rejection.hpp"
+
 namespace covtrack::lcm_wire {
-namespace {
-std::unexpected<DatagramRejection> reject(DatagramFault fault, std::string detail) {
-  return std::unexpected(DatagramRejection{fault, std::move(detail)});
-}
-}  // namespace
 
 Reassembler::Reassembler(ReassemblyLimits limits) : limits_(limits) {
   limits_.max_total_bytes = std::max<std::size_t>(limits_.max_total_bytes, limits_.max_message_bytes);

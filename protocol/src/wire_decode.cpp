@@ -10,6 +10,7 @@
 #include "covtrack/protocol/channels.hpp"
 #include "covtrack/protocol/message_auth.hpp"
 #include "covtrack/protocol/wire_text.hpp"
+#include "rejection.hpp"
 #include "wire_layout.hpp"
 
 namespace covtrack {
@@ -77,10 +78,6 @@ std::optional<std::pair<WireFault, std::string>> check_text(const Field& f, std:
       return std::pair{WireFault::BadText,
                        fmt::format("'{}' holds a control character (at its byte {})", printable(text), *at)};
   return std::nullopt;
-}
-
-std::unexpected<WireRejection> reject(WireFault fault, std::string detail) {
-  return std::unexpected(WireRejection{fault, std::move(detail)});
 }
 
 // A string field's bytes (`body`, its NUL included) that start at byte `at`. LCM strings

@@ -11,11 +11,9 @@
 #include "widget_polygons.hpp"
 
 using namespace covtrack::client;
+using covtrack::client::widget_testing::square;
 
 namespace {
-Polygon square(double x0, double y0, double x1, double y1) {
-  return {Vec2(x0, y0), Vec2(x1, y0), Vec2(x1, y1), Vec2(x0, y1)};
-}
 
 std::string text(const Polygon& p) {
   std::ostringstream out;

@@ -12,14 +12,12 @@
 #include "widget_polygons.hpp"
 
 using namespace covtrack::client;
+using covtrack::client::widget_testing::square;
 
 namespace {
 
 const Box kScreen{Vec2(0, 0), Vec2(640, 480)};
 
-Polygon square(double x0, double y0, double x1, double y1) {
-  return {Vec2(x0, y0), Vec2(x1, y0), Vec2(x1, y1), Vec2(x0, y1)};
-}
 
 // The region shrunk towards its centroid: an inner region inside the outer one.
 Polygon shrunk(const Polygon& p, double factor) {

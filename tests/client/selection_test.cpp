@@ -8,13 +8,12 @@
 #include "covtrack/client/convex_polygon.hpp"
 #include "covtrack/client/selection.hpp"
 #include "covtrack/client/selection_session.hpp"
+#include "widget_polygons.hpp"
 
 using namespace covtrack::client;
+using covtrack::client::widget_testing::square;
 
 namespace {
-Polygon square(double x0, double y0, double x1, double y1) {
-  return {Vec2(x0, y0), Vec2(x1, y0), Vec2(x1, y1), Vec2(x0, y1)};
-}
 Pointer square_pointer(const Vec2& at, double half) {
   return {at, square(at.x() - half, at.y() - half, at.x() + half, at.y() + half)};
 }

@@ -1,10 +1,15 @@
 #pragma once
-// Shared by the widget tests: random convex polygons.
+// Shared by the widget tests: rectangles and random convex polygons.
 #include <random>
 
 #include "covtrack/client/regions.hpp"
 
 namespace covtrack::client::widget_testing {
+
+// The axis-aligned rectangle from (x0, y0) to (x1, y1).
+inline Polygon square(double x0, double y0, double x1, double y1) {
+  return {Vec2(x0, y0), Vec2(x1, y0), Vec2(x1, y1), Vec2(x0, y1)};
+}
 
 // Hull of 3..max_points random points in a box of `half_size` around `center`; on the
 // integer grid when `grid` (many collinear and shared coordinates: degenerate cases).

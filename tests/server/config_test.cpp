@@ -14,8 +14,10 @@
 #include <vector>
 
 #include "config.hpp"
+#include "support/expect_has.hpp"
 
 using covtrack::server::parse_config;
+using covtrack::testing::expect_has;
 
 namespace {
 
@@ -35,10 +37,6 @@ std::string only_error(const std::string& text) {
   std::string msg = r.error().message;
   EXPECT_EQ(std::count(msg.begin(), msg.end(), '\n'), 1) << msg;
   return msg;
-}
-
-void expect_has(const std::string& msg, const std::string& part) {
-  EXPECT_NE(msg.find(part), std::string::npos) << "'" << part << "' not in: " << msg;
 }
 
 }  // namespace

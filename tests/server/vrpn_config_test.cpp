@@ -5,8 +5,10 @@
 #include <string>
 
 #include "config.hpp"
+#include "support/expect_has.hpp"
 
 using covtrack::server::parse_config;
+using covtrack::testing::expect_has;
 
 namespace {
 
@@ -29,10 +31,6 @@ std::string errors_of(const std::string& text) {
   auto r = parse_config(text, "bad.toml");
   EXPECT_FALSE(r) << "config unexpectedly valid:\n" << text;
   return r ? std::string() : r.error().message;
-}
-
-void expect_has(const std::string& msg, const std::string& part) {
-  EXPECT_NE(msg.find(part), std::string::npos) << "'" << part << "' not in: " << msg;
 }
 
 }  // namespace

@@ -6,18 +6,17 @@
 
 #include "covtrack/scene/scene.hpp"
 #include "covtrack/scene/scene_graph.hpp"
+#include "support/expect_has.hpp"
 
 using covtrack::scene::parse_scene;
 using covtrack::scene::scripted_value;
+using covtrack::testing::expect_has;
 
 namespace {
 std::string error_of(const std::string& text) {
   auto r = parse_scene(text, "bad.toml", ".");
   EXPECT_FALSE(r);
   return r ? std::string() : r.error().message;
-}
-void expect_has(const std::string& msg, const std::string& part) {
-  EXPECT_NE(msg.find(part), std::string::npos) << "'" << part << "' not in: " << msg;
 }
 }  // namespace
 

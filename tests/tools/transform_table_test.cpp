@@ -12,10 +12,12 @@
 #include "covtrack/scene/scene.hpp"
 #include "covtrack/scene/scene_graph.hpp"
 #include "covtrack/scene/transform_table.hpp"
+#include "support/expect_has.hpp"
 
 using namespace covtrack;
 using scene::kTransformTableHeader;
 using scene::parse_transform_table;
+using covtrack::testing::expect_has;
 
 namespace {
 
@@ -23,10 +25,6 @@ std::string table_error(const std::string& rows) {
   auto r = parse_transform_table(std::string(kTransformTableHeader) + "\n" + rows, "t.csv");
   EXPECT_FALSE(r) << rows;
   return r ? std::string() : r.error().message;
-}
-
-void expect_has(const std::string& msg, const std::string& part) {
-  EXPECT_NE(msg.find(part), std::string::npos) << "'" << part << "' not in: " << msg;
 }
 
 class TransformTableFiles : public ::testing::Test {
@@ -43,7 +41,7 @@ class TransformTableFiles : public ::testing::Test {
   std::filesystem::path dir_;
 };
 
-const char* kCamera = "[camera]\nframe = \"f0\"\ncalibration = \"c.yml\"\n";
+const char* kCameraSection = "[camera]\nframe = \"f0\"\ncalibration = \"c.yml\"\n";
 
 // T_f0_fN and its covariance through a graph built from the scene.
 client::UncertainPose chain_end(const scene::Scene& s, const std::string& leaf) {
@@ -60,7 +58,7 @@ client::UncertainPose chain_end(const scene::Scene& s, const std::string& leaf) 
 TEST_F(TransformTableFiles, RowsGiveTheSameChainAsTransformTables) {
   // Links with every column different, so a swapped column shows.
   std::string rows = std::string("# a comment, then the header\n\n") + std::string(kTransformTableHeader) + "\n";
-  std::string tables = kCamera;
+  std::string tables = kCameraSection;
   for (int i = 0; i < 50; ++i) {
     const double x = 0.01 * i, y = -0.002 * i, z = 0.03, roll = 1.5 + i, pitch = -2.0, yaw = 0.1 * i;
     const double sx = 1e-4 * (1 + i % 3), sy = 2e-4, sz = 3e-4, sr = 4e-4, sp = 5e-4 * (1 + i % 2), syaw = 6e-4;
@@ -71,7 +69,7 @@ TEST_F(TransformTableFiles, RowsGiveTheSameChainAsTransformTables) {
                           i, i + 1, x, y, z, roll, pitch, yaw, sx, sy, sz, sr, sp, syaw);
   }
   write("links.csv", rows);
-  const std::string scene_path = write("chain.toml", "transform_tables = [\"links.csv\"]\n" + std::string(kCamera));
+  const std::string scene_path = write("chain.toml", "transform_tables = [\"links.csv\"]\n" + std::string(kCameraSection));
   auto from_rows = scene::load_scene(scene_path);
   ASSERT_TRUE(from_rows) << from_rows.error().message;
   auto from_tables = scene::parse_scene(tables, "tables.toml", dir_.string());
@@ -92,7 +90,7 @@ TEST_F(TransformTableFiles, RowsGiveTheSameChainAsTransformTables) {
 TEST_F(TransformTableFiles, TablesAddToTheScenesOwnTransforms) {
   write("more.csv", std::string(kTransformTableHeader) + "\nf1,f2,0,0,1,0,0,0,0.1,0.1,0.1,0,0,0\n");
   const std::string scene_path = write(
-      "mixed.toml", "transform_tables = [\"more.csv\"]\n" + std::string(kCamera) +
+      "mixed.toml", "transform_tables = [\"more.csv\"]\n" + std::string(kCameraSection) +
                         "[[transform]]\nparent = \"f0\"\nchild = \"f1\"\nposition_m = [1, 0, 0]\n"
                         "sigma_m = [0, 0, 0]\nsigma_rad = [0, 0, 0]\n");
   auto s = scene::load_scene(scene_path);
@@ -104,7 +102,7 @@ TEST_F(TransformTableFiles, TablesAddToTheScenesOwnTransforms) {
 }
 
 TEST_F(TransformTableFiles, AMissingTableIsNamedWithTheScenesKey) {
-  const std::string scene_path = write("s.toml", "transform_tables = [\"absent.csv\"]\n" + std::string(kCamera));
+  const std::string scene_path = write("s.toml", "transform_tables = [\"absent.csv\"]\n" + std::string(kCameraSection));
   auto s = scene::load_scene(scene_path);
   ASSERT_FALSE(s);
   expect_has(s.error().message, "s.toml:1:");
@@ -120,7 +118,7 @@ TEST_F(TransformTableFiles, ATableLargerThanAConfigFileLoads) {
     rows += fmt::format("f{},f{},0.001,0.002,0.003,0.1,0.2,0.3,0.0001,0.0001,0.0001,0.0001,0.0001,0.0001\n", i, i + 1);
   ASSERT_GT(rows.size(), std::size_t(4) << 20);
   write("big.csv", rows);
-  const std::string scene_path = write("s.toml", "transform_tables = [\"big.csv\"]\n" + std::string(kCamera));
+  const std::string scene_path = write("s.toml", "transform_tables = [\"big.csv\"]\n" + std::string(kCameraSection));
   auto s = scene::load_scene(scene_path);
   ASSERT_TRUE(s) << s.error().message;
   EXPECT_EQ(s->transforms.size(), std::size_t(links));

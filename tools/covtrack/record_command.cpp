@@ -30,17 +30,17 @@ struct RecordArgs {
 // since LCM's handle() cannot be interrupted.
 int g_stop_pipe_write = -1;
 
-void on_stop_signal(int) {
+void write_stop_byte(int) {
   const char byte = 1;
   [[maybe_unused]] auto ignored = ::write(g_stop_pipe_write, &byte, 1);
 }
 
-int install_stop_signals() {
+int install_stop_pipe() {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC | O_NONBLOCK) != 0) return -1;
   g_stop_pipe_write = fds[1];
   struct sigaction action {};
-  action.sa_handler = on_stop_signal;
+  action.sa_handler = write_stop_byte;
   sigemptyset(&action.sa_mask);
   ::sigaction(SIGINT, &action, nullptr);
   ::sigaction(SIGTERM, &action, nullptr);
@@ -71,7 +71,7 @@ int run_record(const RecordArgs& args) {
     fmt::print(stderr, "covtrack record: {}\n", writer.error().message);
     return 1;
   }
-  const int stop_fd = install_stop_signals();
+  const int stop_fd = install_stop_pipe();
   auto recorder = lcmlog::Recorder::start(**lcm, *writer, args.channels);
   if (!recorder) {
     fmt::print(stderr, "covtrack record: {}\n", recorder.error().message);

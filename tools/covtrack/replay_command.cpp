@@ -1,8 +1,6 @@
 // `covtrack replay FILE`: publishes an LCM log with its original timing.
-#include <signal.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -14,6 +12,7 @@
 #include "covtrack/lcmlog/log_reader.hpp"
 #include "covtrack/lcmlog/replayer.hpp"
 #include "covtrack/protocol/lcm_url.hpp"
+#include "stop_signal.hpp"
 
 namespace covtrack::cli {
 namespace {
@@ -23,19 +22,6 @@ struct ReplayArgs {
   lcmlog::ReplayOptions options;
   std::string lcm_url;
 };
-
-std::atomic<bool> g_stop{false};  // lock-free, so a signal handler may set it
-static_assert(std::atomic<bool>::is_always_lock_free);
-
-void on_stop_signal(int) { g_stop.store(true); }
-
-void install_stop_signals() {
-  struct sigaction action {};
-  action.sa_handler = on_stop_signal;
-  sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, nullptr);
-  ::sigaction(SIGTERM, &action, nullptr);
-}
 
 // One line rewritten in place at most 10 times a second; only on a terminal, so logs of
 // scripted runs stay clean.
@@ -80,7 +66,7 @@ int run_replay(const ReplayArgs& args) {
   }
   install_stop_signals();
   ProgressLine progress;
-  auto summary = lcmlog::replay(*reader, **lcm, args.options, g_stop,
+  auto summary = lcmlog::replay(*reader, **lcm, args.options, stop_requested(),
                                 [&](const lcmlog::ReplayProgress& p) { progress.update(p); });
   progress.finish();
   if (!summary) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plane_cross.hpp"
+
 namespace covtrack::client {
 namespace {
 
@@ -63,10 +65,6 @@ Chains split_into_chains(const Polygon& p) {
 void append_xs(const Chain& c, double lo, double hi, std::vector<double>& xs) {
   for (const Vec2& p : c.points)
     if (p.x() > lo && p.x() < hi) xs.push_back(p.x());
-}
-
-double cross(const Vec2& o, const Vec2& a, const Vec2& b) {
-  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
 }
 
 // Drops repeated and (nearly) collinear vertices so the result is a proper polygon.

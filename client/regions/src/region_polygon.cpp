@@ -4,14 +4,11 @@
 #include <numeric>
 
 #include "covtrack/client/regions.hpp"
+#include "plane_cross.hpp"
 #include "vector_clones.hpp"
 
 namespace covtrack::client {
 namespace {
-double cross(const Vec2& o, const Vec2& a, const Vec2& b) {
-  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
-}
-
 // Up to this many points (an object's box) take the hull by successors below.
 constexpr int kFewPoints = 8;
 

@@ -17,27 +17,30 @@ namespace {
 
 // Edges solved side by side: loops of fixed length without branches over structure-of-
 // arrays data, which vectorise (vector_clones.hpp), as the projection's blocks do. A block
-// holds kEdges = kLanes - 1 edges, so that each loop runs over exactly kLanes lanes: with
-// kLanes edges the vertices' loop needed one lane more, done without vectors, and its
-// square root and division waited on each other.
-constexpr std::size_t kLanes = 8;
-constexpr std::size_t kEdges = kLanes - 1;
+// holds kEdges = kEdgeLanes - 1 edges, so that each loop runs over exactly kEdgeLanes
+// lanes: with kEdgeLanes edges the vertices' loop needed one lane more, done without
+// vectors, and its square root and division waited on each other.
+constexpr std::size_t kEdgeLanes = 8;
+constexpr std::size_t kEdges = kEdgeLanes - 1;
 
 // A block of hull edges: lane l holds hull vertex first + l (cyclic) and the edge that
 // starts there; lane kEdges only the last edge's end (its own edge is computed and not
-// used), and lane kLanes, zero, what that unused edge reads. Per vertex the object point,
-// the pixel covariance (xx, xy, yy) and the outward normal of its edge; then M, the pixel's
-// derivative by the object-frame point (2x3, rows m0, m1). The pose (covariance C, row-
-// major; rotation R, translation t) and the focal lengths too: members of one struct, so
-// that the compiler sees that no store into a lane's arrays changes them, and vectorises
-// without checks for overlap (it gives up on too many of them).
+// used), and lane kEdgeLanes, zero, what that unused edge reads. Per vertex the object
+// point, the pixel covariance (xx, xy, yy) and the outward normal of its edge; then M,
+// the pixel's derivative by the object-frame point (2x3, rows m0, m1). The pose
+// (covariance C, row-major; rotation R, translation t) and the focal lengths too:
+// members of one struct, so that the compiler sees that no store into a lane's arrays
+// changes them, and vectorises without checks for overlap (it gives up on too many of
+// them).
 struct EdgeBlock {
   double C[36], R[9], t[3], fx, fy;
-  double px[kLanes + 1], py[kLanes + 1], pz[kLanes + 1], sxx[kLanes + 1], sxy[kLanes + 1], syy[kLanes + 1];
-  double u[kLanes + 1], v[kLanes + 1];  // mean pixels, one more: the normal of lane kEdges's edge
-  double nx[kLanes + 1], ny[kLanes + 1];
-  double m00[kLanes + 1], m01[kLanes + 1], m02[kLanes + 1], m10[kLanes + 1], m11[kLanes + 1], m12[kLanes + 1];
-  double length[kLanes];
+  double px[kEdgeLanes + 1], py[kEdgeLanes + 1], pz[kEdgeLanes + 1];
+  double sxx[kEdgeLanes + 1], sxy[kEdgeLanes + 1], syy[kEdgeLanes + 1];
+  double u[kEdgeLanes + 1], v[kEdgeLanes + 1];  // mean pixels, one more: the normal of lane kEdges's edge
+  double nx[kEdgeLanes + 1], ny[kEdgeLanes + 1];
+  double m00[kEdgeLanes + 1], m01[kEdgeLanes + 1], m02[kEdgeLanes + 1];
+  double m10[kEdgeLanes + 1], m11[kEdgeLanes + 1], m12[kEdgeLanes + 1];
+  double length[kEdgeLanes];
 };
 
 // Each edge's jump and its end vertex's arc (see whole_object_scale2), into length[e].
@@ -49,7 +52,7 @@ struct EdgeBlock {
 COVTRACK_VECTOR_CLONES
 void edge_lengths(EdgeBlock& h) {
   const double(&C)[36] = h.C, (&R)[9] = h.R, (&t)[3] = h.t, fx = h.fx, fy = h.fy;
-  for (std::size_t l = 0; l < kLanes; ++l) {
+  for (std::size_t l = 0; l < kEdgeLanes; ++l) {
     h.nx[l] = h.v[l + 1] - h.v[l], h.ny[l] = h.u[l] - h.u[l + 1];
     const double x = R[0] * h.px[l] + R[1] * h.py[l] + R[2] * h.pz[l] + t[0];
     const double y = R[3] * h.px[l] + R[4] * h.py[l] + R[5] * h.pz[l] + t[1];
@@ -57,7 +60,7 @@ void edge_lengths(EdgeBlock& h) {
     h.m00[l] = fx * (z * R[0] - x * R[6]), h.m01[l] = fx * (z * R[1] - x * R[7]), h.m02[l] = fx * (z * R[2] - x * R[8]);
     h.m10[l] = fy * (z * R[3] - y * R[6]), h.m11[l] = fy * (z * R[4] - y * R[7]), h.m12[l] = fy * (z * R[5] - y * R[8]);
   }
-  for (std::size_t e = 0; e < kLanes; ++e) {
+  for (std::size_t e = 0; e < kEdgeLanes; ++e) {
     const std::size_t f = e + 1;
     const double nx = h.nx[e], ny = h.ny[e];
     // J^T n = [w, p x w] with w = M^T n, for the edge's two vertices.
@@ -135,13 +138,13 @@ double whole_object_scale2(const Camera& camera, const UncertainPose& pose,
   }
   h.fx = camera.fx, h.fy = camera.fy;
   for (double* spare : {h.px, h.py, h.pz, h.sxx, h.sxy, h.syy, h.nx, h.ny, h.m00, h.m01, h.m02, h.m10, h.m11, h.m12})
-    spare[kLanes] = 0;
+    spare[kEdgeLanes] = 0;
   double length = 0;
   for (std::size_t first = 0; first < k; first += kEdges) {
-    for (std::size_t l = 0, i = first % k; l <= kLanes; ++l, i = i + 1 == k ? 0 : i + 1) {
+    for (std::size_t l = 0, i = first % k; l <= kEdgeLanes; ++l, i = i + 1 == k ? 0 : i + 1) {
       const ProjectedVertex& pv = projected[mean_hull[i]];
       h.u[l] = pv.mean_px.x(), h.v[l] = pv.mean_px.y();
-      if (l == kLanes) break;
+      if (l == kEdgeLanes) break;
       const Vec3& p = vertices_object[mean_hull[i]];
       h.px[l] = p.x(), h.py[l] = p.y(), h.pz[l] = p.z();
       const Mat2& S = pv.covariance_px2;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "covtrack/client/projection.hpp"
+#include "plane_cross.hpp"
 
 namespace covtrack::client {
 
@@ -93,8 +94,6 @@ void hull_tangents(std::size_t k, HullVertex vertex, double scale2, std::vector<
                    std::vector<TangentLine>* outer) {
   hull_tangents(k, vertex, scale2, scale2, inner, outer);
 }
-
-inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // Where two lines n . x = h (normals less than pi apart) cross: the corners of both regions.
 inline Vec2 corner(const Vec2& na, double ha, const Vec2& nb, double hb) {

@@ -8,11 +8,11 @@
 
 namespace covtrack::vrpn {
 namespace {
-bool printable(char c) { return c >= 0x20 && c < 0x7f; }
+bool is_printable(char c) { return c >= 0x20 && c < 0x7f; }
 }  // namespace
 
 bool is_valid_vrpn_name(std::string_view name) {
-  return !name.empty() && name.size() <= kMaxVrpnNameLength && std::all_of(name.begin(), name.end(), printable);
+  return !name.empty() && name.size() <= kMaxVrpnNameLength && std::all_of(name.begin(), name.end(), is_printable);
 }
 
 std::vector<std::uint8_t> name_description(std::string_view name) {
@@ -46,7 +46,7 @@ std::vector<std::uint8_t> udp_description(std::string_view host) {
 Result<std::string> parse_udp_description(std::span<const std::uint8_t> payload) {
   const auto nul = std::find(payload.begin(), payload.end(), std::uint8_t{0});
   std::string host(payload.begin(), nul);
-  if (nul == payload.end() || host.empty() || host.size() > 255 || !std::all_of(host.begin(), host.end(), printable))
+  if (nul == payload.end() || host.empty() || host.size() > 255 || !std::all_of(host.begin(), host.end(), is_printable))
     return fail("VRPN UDP description holds no NUL-terminated host name");
   return host;
 }
