@@ -69,7 +69,8 @@ TEST_F(TransformTableFiles, RowsGiveTheSameChainAsTransformTables) {
                           i, i + 1, x, y, z, roll, pitch, yaw, sx, sy, sz, sr, sp, syaw);
   }
   write("links.csv", rows);
-  const std::string scene_path = write("chain.toml", "transform_tables = [\"links.csv\"]\n" + std::string(kCameraSection));
+  const std::string scene_path =
+      write("chain.toml", "transform_tables = [\"links.csv\"]\n" + std::string(kCameraSection));
   auto from_rows = scene::load_scene(scene_path);
   ASSERT_TRUE(from_rows) << from_rows.error().message;
   auto from_tables = scene::parse_scene(tables, "tables.toml", dir_.string());
