@@ -5,6 +5,9 @@
 
 namespace covtrack::cli {
 
+// Lock-free, so that a signal handler may set it.
+static_assert(std::atomic<bool>::is_always_lock_free);
+
 inline std::atomic<bool>& stop_requested() {
   static std::atomic<bool> flag{false};
   return flag;
