@@ -1,4 +1,5 @@
 // Run by hand (about 5 min; seconds with a cache): build/tests/devices/fiducial_corner_terms_probe [CACHE_DIR]
+// or, for the phase-locked views alone: build/tests/devices/fiducial_corner_terms_probe --locked
 // How well each term of the corner noise model matches the corner errors, by the tag's
 // size in pixels, distance band, rasteriser, tone curve and camera, on the held-out check's calibration set and (for
 // reporting only: nothing is fitted on it) its validation set. The model is the one the
@@ -11,6 +12,7 @@
 // the corners' centroid against its modelled variance, the corner errors by edge mode,
 // and the pose NEES with one term's variance halved (which term the pose's covariance
 // rests on). An optional argument names a folder that caches the draws between runs.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -358,10 +360,15 @@ void add_view(Group& g, const TagRun& run, const std::vector<ViewDraw>& draws, c
   const CornerNoise noise = m.noise(used[0]->inputs);
   g.scale.observed += common * common - mean_var / (4 * n);
   g.scale.modelled += noise.scale_sigma_px * noise.scale_sigma_px;
+  // The phase-locked terms are each edge's own: their mean over the edges joins the
+  // edge's and the turn's modelled variance.
+  double locked_edge = 0, locked_tilt = 0;
+  for (std::size_t k = 0; k < 4; ++k)
+    locked_edge += std::pow(noise.locked_edge_px[k], 2) / 4, locked_tilt += std::pow(noise.locked_tilt_px[k], 2) / 4;
   g.edge.observed += (rest - 0.75 * mean_var / n) * 4 / 3;
-  g.edge.modelled += noise.edge_sigma_px * noise.edge_sigma_px;
+  g.edge.modelled += noise.edge_sigma_px * noise.edge_sigma_px + locked_edge;
   g.turn.observed += turn_sq - turn_mean_var / n;
-  g.turn.modelled += noise.tilt_sigma_px * noise.tilt_sigma_px;
+  g.turn.modelled += noise.tilt_sigma_px * noise.tilt_sigma_px + locked_tilt;
   int posed = 0;
   const double nees = mean_pose_nees(run.view, draws, m, &posed);
   g.nees_sum += nees * posed, g.nees_n += posed, ++g.views;
@@ -394,6 +401,54 @@ void print_terms(const char* set, const std::vector<TagRun>& runs, const Draws& 
     std::printf("  %-16s %5d %6.2f %6.2f %6.2f %6.2f %6.2f\n", label.c_str(), g.views,
                 g.nees_n ? g.nees_sum / g.nees_n : 0, g.indep.value(), g.scale.value(), g.edge.value(),
                 g.turn.value());
+}
+
+// Per draw, the corner errors in the edge modes of the draw's own quad (edge_line_modes:
+// 4 outward offsets, 4 turns), split into the tag's apparent scale (the offsets' mean),
+// each edge's own placement (the rest of the offsets) and the turns; each part's mean
+// square against the same part of the model's full corner covariance (phase-locked terms
+// included), so that a term's excess shows apart from the others. By the tag's mean edge
+// length, camera and whether any edge is locked (lock over 0.5).
+void print_mode_terms(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
+  struct Parts {
+    Ratio scale, placement, turn;
+    int draws = 0;
+  };
+  std::map<std::string, Parts> groups;
+  const Eigen::Matrix4d rest = Eigen::Matrix4d::Identity() - Eigen::Matrix4d::Constant(0.25);
+  for (std::size_t v = 0; v < runs.size(); ++v)
+    for (const ViewDraw& d : draws[v]) {
+      if (!d.detection || !std::isfinite(d.inputs.blur_px)) continue;
+      const CornerErrors e = corner_errors(m, d);
+      std::array<cv::Point2d, 4> corners;
+      Eigen::Matrix<double, 8, 1> error;
+      for (int k = 0; k < 4; ++k) {
+        corners[k] = d.truth_px[k] + e.error_px[k];
+        error(2 * k) = e.error_px[k].x, error(2 * k + 1) = e.error_px[k].y;
+      }
+      const Eigen::Matrix<double, 8, 8> to_modes = edge_line_modes(corners).inverse();
+      const Eigen::Matrix<double, 8, 1> q = to_modes * error;
+      const Eigen::Matrix<double, 8, 8> C = to_modes * corner_covariance(corners, corner_noise(m, d)) * to_modes.transpose();
+      const Eigen::Matrix4d offsets = C.topLeftCorner<4, 4>();
+      const double length = d.inputs.edge_length_px;
+      const bool locked = *std::max_element(d.inputs.phase_lock.begin(), d.inputs.phase_lock.end()) > 0.5;
+      const std::string keys[] = {length < 60 ? "edge <60 px" : length < 150 ? "edge 60-150 px" : "edge 150+ px",
+                                  "camera " + std::to_string(runs[v].view.camera.width_px),
+                                  locked ? "an edge locked" : "none locked", "all"};
+      for (const std::string& key : keys) {
+        Parts& p = groups[key];
+        const double s = q.head<4>().mean();
+        p.scale.observed += s * s, p.scale.modelled += offsets.sum() / 16;
+        p.placement.observed += (rest * q.head<4>()).squaredNorm(), p.placement.modelled += (rest * offsets * rest).trace();
+        p.turn.observed += q.tail<4>().squaredNorm(), p.turn.modelled += C.bottomRightCorner<4, 4>().trace();
+        ++p.draws;
+      }
+    }
+  std::printf("%s: per draw, observed / modelled mean square in the quad's edge modes\n", set);
+  std::printf("  %-16s %6s %7s %9s %6s\n", "group", "draws", "scale", "placement", "turn");
+  for (const auto& [label, p] : groups)
+    std::printf("  %-16s %6d %7.2f %9.2f %6.2f\n", label.c_str(), p.draws, p.scale.value(), p.placement.value(),
+                p.turn.value());
 }
 
 void print_directions(const char* set, const std::vector<TagRun>& runs, const Draws& draws, const CornerNoiseModel& m) {
@@ -466,6 +521,19 @@ void print_halved(const char* set, const std::vector<TagRun>& runs, const Draws&
 }  // namespace
 
 int main(int argc, char** argv) {
+  // --locked: only the phase-locked views (fiducial_heldout_nees_test's seeds), under the
+  // shipped model, by mode (seconds, not minutes).
+  if (argc > 1 && std::string(argv[1]) == "--locked") {
+    const CornerNoiseModel shipped;
+    const auto calibration = test::locked_edge_calibration_set();
+    const auto validation = test::locked_edge_validation_set();
+    const Draws calibration_draws = draws_of(calibration, 7000), validation_draws = draws_of(validation, 8000);
+    print_mode_terms("locked calibration", calibration, calibration_draws, shipped);
+    print_mode_terms("locked validation", validation, validation_draws, shipped);
+    print_terms("locked calibration", calibration, calibration_draws, shipped);
+    print_terms("locked validation", validation, validation_draws, shipped);
+    return 0;
+  }
   // Optional: a cache folder for the draws (see cached_draws).
   const std::string cache = argc > 1 ? argv[1] : "";
   const auto calibration = test::calibration_set();
