@@ -72,9 +72,8 @@ std::pair<double, double> full_height_span(const SmallPolygon& band, double top,
 void add_polygon(cv::Mat& image, const Polygon& quad, float value, double aperture) {
   const double half = aperture / 2, per_area = 1 / (aperture * aperture);
   SmallPolygon poly;
-  for (const auto& q : quad) poly.p[poly.n++] = q;
   double y_lo = 1e18, y_hi = -1e18;
-  for (const auto& p : quad) y_lo = std::min(y_lo, p.y), y_hi = std::max(y_hi, p.y);
+  for (const auto& q : quad) poly.p[poly.n++] = q, y_lo = std::min(y_lo, q.y), y_hi = std::max(y_hi, q.y);
   const int r0 = std::max(0, static_cast<int>(std::floor(y_lo + 0.5)));
   const int r1 = std::min(image.rows - 1, static_cast<int>(std::floor(y_hi + 0.5)));
   for (int r = r0; r <= r1; ++r) {
