@@ -134,11 +134,11 @@ TEST(BoardCalibration, RecoversTheModelItsCornersWereDrawnFrom) {
     const BoardConsistency best = board_consistency(cam, b, frames, truth);
     std::printf("true model's board consistency %.2f (%.1f%% above)\n", best.mean_chi2, 100 * best.above_99);
     std::printf("drawn from bias %.3f, factors %.2f %.2f %.2f: fitted %.4f +- %.4f, %.3f +- %.3f, %.3f +- %.3f, "
-                "%.3f +- %.3f over %d views (%d left out); residual NEES %.2f; board consistency %.2f "
+                "%.3f +- %.3f over %d views (%d left out, %d passes); residual NEES %.2f; board consistency %.2f "
                 "before, %.2f after\n",
                 c.bias, c.independent, c.scale, c.edge, fit->scale_bias_per_blur, fit->scale_bias_se,
                 fit->independent_factor, fit->independent_se, fit->scale_factor, fit->scale_se, fit->edge_factor,
-                fit->edge_se, fit->residuals, fit->left_out, fit->mean_residual_nees,
+                fit->edge_se, fit->residuals, fit->left_out, fit->passes, fit->mean_residual_nees,
                 fit->before.mean_chi2, fit->after.mean_chi2);
     // Each value within 4 of its standard errors (what these frames can tell), and the
     // ones that set a pose's covariance within a stated tolerance.
@@ -156,6 +156,40 @@ TEST(BoardCalibration, RecoversTheModelItsCornersWereDrawnFrom) {
     EXPECT_NEAR(fit->after.mean_chi2 / best.mean_chi2, 1, 0.05);
     EXPECT_LT(fit->after.mean_chi2, fit->before.mean_chi2);
   }
+}
+
+// The residuals are built under a model, and the fit's value once depended on it: edge
+// factor 2.00 drawn, 2.16 fitted under the defaults, 1.84 under that fit. Fits that start
+// from the defaults and from a model far on the other side must end at the same values.
+// Catches a fit that stops before the model it builds its residuals under is its own.
+TEST(BoardCalibration, TheFitDoesNotDependOnTheModelItStartsFrom) {
+  const Camera cam = test::camera(800, 600, 58);
+  auto family = TagFamily::open("tag36h11");
+  ASSERT_TRUE(family.has_value());
+  const TagBundle b = board(0.045);
+  const CornerNoiseModel truth = camera_model(-0.42, 1.4, 0.4, 2.0);
+  const auto frames = drawn_frames(cam, b, **family, truth, 150, 5);
+  // A fit's factors are relative to the model it starts from: this one's are these.
+  constexpr double kI = 2.0, kS = 1.0, kE = 3.0;
+  auto from_defaults = fit_board_calibration(cam, b, frames, CornerNoiseModel{});
+  auto from_above = fit_board_calibration(cam, b, frames, camera_model(-0.2, kI, kS, kE));
+  ASSERT_TRUE(from_defaults.has_value()) << from_defaults.error().message;
+  ASSERT_TRUE(from_above.has_value()) << from_above.error().message;
+  const BoardFit& a = *from_defaults;
+  const BoardFit& c = *from_above;
+  std::printf("from the defaults: bias %.4f, factors %.3f %.3f %.3f, %d passes (%s)\n", a.scale_bias_per_blur,
+              a.independent_factor, a.scale_factor, a.edge_factor, a.passes, a.settled ? "settled" : "not settled");
+  std::printf("from above: bias %.4f, factors %.3f %.3f %.3f, %d passes (%s)\n", c.scale_bias_per_blur,
+              kI * c.independent_factor, kS * c.scale_factor, kE * c.edge_factor, c.passes,
+              c.settled ? "settled" : "not settled");
+  EXPECT_TRUE(a.settled);
+  EXPECT_TRUE(c.settled);
+  // Each settled within a tenth of a standard error a pass, so within a few tenths of
+  // each other; a half is the bar.
+  EXPECT_NEAR(a.scale_bias_per_blur, c.scale_bias_per_blur, 0.5 * a.scale_bias_se);
+  EXPECT_NEAR(a.independent_factor, kI * c.independent_factor, 0.5 * a.independent_se);
+  EXPECT_NEAR(a.scale_factor, kS * c.scale_factor, 0.5 * a.scale_se);
+  EXPECT_NEAR(a.edge_factor, kE * c.edge_factor, 0.5 * a.edge_se);
 }
 
 namespace {

@@ -50,6 +50,12 @@ void print_fit(const fiducial::BoardFit& fit, const fiducial::CornerNoiseModel& 
   fmt::print("{} tag views fitted from {} frames ({} left out as gross errors: residual NEES above 100); median edge "
              "blur {:.2f} px\n",
              fit.residuals, fit.frames_used, fit.left_out, fit.median_blur_px);
+  if (fit.settled)
+    fmt::print("settled in {} passes (the residuals rebuilt under each fit)\n", fit.passes);
+  else
+    fmt::print("not settled in {} passes: the last still moved a value by more than a tenth of its standard "
+               "error (its fit is the one written)\n",
+               fit.passes);
   fmt::print("  {:<34} {:>9} {:>9}\n", "", "before", "fitted");
   fmt::print("  {:<34} {:>9.4f} {:>9.4f} +- {:.4f}\n", "corner_scale_bias_per_blur", start.scale_bias_per_blur,
              fit.scale_bias_per_blur, fit.scale_bias_se);

@@ -25,6 +25,11 @@ using Mat84 = Eigen::Matrix<double, 8, 4>;
 constexpr double kGrossResidualNees = 100;
 constexpr double kChi2_6_99 = 16.812;
 constexpr int kMinResiduals = 30;
+// Passes of building the residuals under the last fit (fit_board_calibration): the
+// tests' fits settle in 4 or 5 (each overshoot about a quarter of the one before); a pass
+// has settled when it moves every value by less than this many of its standard errors.
+constexpr int kMaxPasses = 10;
+constexpr double kSettledInSe = 0.1;
 
 // One tag view as the fit sees it (see board_calibration.hpp).
 struct Residual {
@@ -275,10 +280,16 @@ Result<BoardFit> fit_board_calibration(const Camera& camera, const TagBundle& bo
   BoardFit fit;
   Params p{start.scale_bias_per_blur, 0, 0, 0};
   std::vector<Residual> used;
-  // The fitted model corrects the scale bias before the tags place each other, which
-  // moves the residuals a little: a second pass with it settles them.
-  for (int pass = 0; pass < 2; ++pass) {
-    const CornerNoiseModel model = pass == 0 ? start : with_factors(start, p);
+  // The residuals are built under a model: it corrects the scale bias before the tags
+  // place each other, and it sets the covariance of that placement (Residual::prediction),
+  // which the likelihood takes as known. Fitted under a model whose edge factor is too
+  // small, the placement's error is underrated and the fit puts it into the tag's own
+  // terms; under one too large, the reverse: the fit over- and undershoots in turn (edge
+  // factor 2.00 drawn: 2.16 under the starting model, 1.84 under that). So the residuals are
+  // rebuilt under each fit until a pass moves no value by a tenth of its standard error
+  // (the model the residuals are built under is then the one they fit).
+  for (int pass = 1;; ++pass) {
+    const CornerNoiseModel model = with_factors(start, p);
     std::vector<Residual> all = residuals_of(camera, board, frames, model, ambiguity_chi2, fit.frames_used);
     if (static_cast<int>(all.size()) < kMinResiduals)
       return fail(fmt::format("only {} tag views could be predicted from the board's other tags in {} frames "
@@ -293,17 +304,23 @@ Result<BoardFit> fit_board_calibration(const Camera& camera, const TagBundle& bo
     fit.left_out = static_cast<int>(all.size() - used.size());
     if (static_cast<int>(used.size()) < kMinResiduals) return fail("too many tag views disagree with their board");
     q = maximise_likelihood(used, q);
+    const Params se = standard_errors(used, q);
+    fit.settled = std::abs(q[0] - p[0]) < kSettledInSe * se[0];
     // Compose with the model the residuals were built under.
     p[0] = q[0];
-    for (std::size_t i = 1; i < kParams; ++i) p[i] += q[i];
+    for (std::size_t i = 1; i < kParams; ++i) {
+      p[i] += q[i];
+      fit.settled = fit.settled && std::abs(q[i]) < kSettledInSe * se[i];
+    }
     double nees = 0;
     for (const Residual& v : used) nees += residual_nees(v, q);
     fit.mean_residual_nees = nees / static_cast<double>(used.size());
-    const Params se = standard_errors(used, q);
     fit.scale_bias_se = se[0];
     // A log factor's standard error is its factor's relative one.
     fit.independent_se = std::exp(p[1]) * se[1], fit.scale_se = std::exp(p[2]) * se[2];
     fit.edge_se = std::exp(p[3]) * se[3];
+    fit.passes = pass;
+    if (fit.settled || pass == kMaxPasses) break;
   }
   fit.model = with_factors(start, p);
   fit.scale_bias_per_blur = p[0];

@@ -61,6 +61,8 @@ struct BoardFit {
   int frames_used = 0;       // frames with at least three of the board's tags
   int residuals = 0;         // tag views the fit used
   int left_out = 0;          // residuals left out as outliers
+  int passes = 0;            // residuals built anew under each fit until it settled
+  bool settled = false;      // the last pass moved no value by a tenth of its standard error
   double mean_residual_nees = 0;  // of the used residuals under the fit (8 expected)
   double median_blur_px = 0;
   BoardConsistency before, after;  // under the starting model and under the fitted one
