@@ -88,6 +88,8 @@ TEST_F(CalibrateFiducialCli, FitsARenderedBoardAndTheDeviceReadsTheFile) {
   std::printf("%s", run.out.c_str());
   ASSERT_EQ(run.exit_code, 0) << run.out;
   EXPECT_NE(run.out.find("30 frames read"), std::string::npos) << run.out;
+  // The fit's passes settled (a line of its own: "not settled in N passes" otherwise).
+  EXPECT_NE(run.out.find("\nsettled in "), std::string::npos) << run.out;
 
   double bias = 0, bias_se = 0, independent = 0, independent_se = 0, scale = 0, scale_se = 0;
   ASSERT_TRUE(fitted(run.out, "corner_scale_bias_per_blur", bias, bias_se)) << run.out;

@@ -26,7 +26,7 @@ constexpr double kGrossResidualNees = 100;
 constexpr double kChi2_6_99 = 16.812;
 constexpr int kMinResiduals = 30;
 // Passes of building the residuals under the last fit (fit_board_calibration): the
-// tests' fits settle in 4 or 5 (each overshoot about a quarter of the one before); a pass
+// tests' fits settle in 3 to 5 (each overshoot about a quarter of the one before); a pass
 // has settled when it moves every value by less than this many of its standard errors.
 constexpr int kMaxPasses = 10;
 constexpr double kSettledInSe = 0.1;
