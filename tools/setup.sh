@@ -16,6 +16,7 @@ packages=(build-essential cmake pkg-config liblcm-dev liblcm-bin libeigen3-dev
           default-jdk-headless liblcm-java libjchart2d-java
           libopenscenegraph-dev libgl1-mesa-dri  # the 3-D AR adapter; Mesa draws its tests
           file  # file: cpack -G DEB finds the ELF files for dpkg-shlibdeps with it
+          ninja-build  # the build tool of a new build tree (docs/design.md, "Build time")
           clang-16 libclang-rt-16-dev)  # the fuzzers and the sanitized tests (libFuzzer, ASan, UBSan)
 missing=()
 for p in "${packages[@]}"; do
@@ -35,6 +36,11 @@ fi
 # templates they share are instantiated once a batch, not once a file (CI's build: 908 to
 # 702 s). A source's file-local names must then differ from its batch neighbours'
 # (docs/design.md, "Build time"). For quick rebuilds of one file: -DCMAKE_UNITY_BUILD=OFF.
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -DNDEBUG" -DCMAKE_UNITY_BUILD=ON \
-      "-DCMAKE_C_FLAGS_RELEASE=-O2 -DNDEBUG" >/dev/null
+# A new tree is built by Ninja, which compiles a target's sources while the libraries it
+# links are still being built (Make waits for them); a tree configured before keeps its
+# generator, since CMake refuses to change it.
+generator=()
+[[ -f "$build_dir/CMakeCache.txt" ]] || generator=(-G Ninja)
+cmake "${generator[@]}" -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -DNDEBUG" \
+      -DCMAKE_UNITY_BUILD=ON "-DCMAKE_C_FLAGS_RELEASE=-O2 -DNDEBUG" >/dev/null
 cmake --build "$build_dir" -j"$(nproc)"
