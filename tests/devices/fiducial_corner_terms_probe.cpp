@@ -317,6 +317,10 @@ bool near_band(const TagRun& r) { return r.view.tag.T_camera_tag.translation().z
 struct Ratio {
   double observed = 0, modelled = 0;
   double value() const { return modelled > 0 ? observed / modelled : 0; }
+  Ratio& operator+=(const Ratio& r) {
+    observed += r.observed, modelled += r.modelled;
+    return *this;
+  }
 };
 struct Group {
   Ratio indep, scale, edge, turn;
@@ -435,12 +439,14 @@ void print_mode_terms(const char* set, const std::vector<TagRun>& runs, const Dr
       const std::string keys[] = {length < 60 ? "edge <60 px" : length < 150 ? "edge 60-150 px" : "edge 150+ px",
                                   "camera " + std::to_string(runs[v].view.camera.width_px),
                                   locked ? "an edge locked" : "none locked", "all"};
+      const double s = q.head<4>().mean();
+      const Parts draw{{s * s, offsets.sum() / 16},
+                       {(rest * q.head<4>()).squaredNorm(), (rest * offsets * rest).trace()},
+                       {q.tail<4>().squaredNorm(), C.bottomRightCorner<4, 4>().trace()},
+                       1};
       for (const std::string& key : keys) {
         Parts& p = groups[key];
-        const double s = q.head<4>().mean();
-        p.scale.observed += s * s, p.scale.modelled += offsets.sum() / 16;
-        p.placement.observed += (rest * q.head<4>()).squaredNorm(), p.placement.modelled += (rest * offsets * rest).trace();
-        p.turn.observed += q.tail<4>().squaredNorm(), p.turn.modelled += C.bottomRightCorner<4, 4>().trace();
+        p.scale += draw.scale, p.placement += draw.placement, p.turn += draw.turn;
         ++p.draws;
       }
     }

@@ -125,11 +125,12 @@ Params standard_errors(const std::vector<Residual>& residuals, const Params& p) 
     x[static_cast<std::size_t>(i)] += di, x[static_cast<std::size_t>(j)] += dj;
     return nll.calc(x.data());
   };
+  // Symmetric: each pair once (the fit asks for these every pass).
   Eigen::Matrix<double, kParams, kParams> H;
   for (int i = 0; i < kParams; ++i)
-    for (int j = 0; j < kParams; ++j) {
+    for (int j = i; j < kParams; ++j) {
       const double hi = h[static_cast<std::size_t>(i)], hj = h[static_cast<std::size_t>(j)];
-      H(i, j) = (at(i, hi, j, hj) - at(i, hi, j, -hj) - at(i, -hi, j, hj) + at(i, -hi, j, -hj)) / (4 * hi * hj);
+      H(i, j) = H(j, i) = (at(i, hi, j, hj) - at(i, hi, j, -hj) - at(i, -hi, j, hj) + at(i, -hi, j, -hj)) / (4 * hi * hj);
     }
   const Eigen::Matrix<double, kParams, kParams> C = 2 * H.inverse();
   Params se;
